@@ -1,0 +1,1 @@
+"""Default parameters and presets (YAML), read by the pipeline."""

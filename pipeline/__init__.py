@@ -1,0 +1,1 @@
+"""Scene model and validation, stage runner, cache, executors and the CLI."""

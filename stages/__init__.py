@@ -1,0 +1,1 @@
+"""Stages: each turns named inputs into named outputs by calling engine kernels."""

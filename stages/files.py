@@ -1,0 +1,97 @@
+"""Image and array files: atomic writes, PNG reading and writing.
+
+Every product of a render is written to a temporary file in the destination folder and
+renamed into place, so a killed render never leaves a partial file under a final name.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import tempfile
+from pathlib import Path
+
+import imageio.v3 as iio
+import numpy as np
+
+from fluidymation.errors import InputError
+
+
+@contextlib.contextmanager
+def atomic_path(path: str | os.PathLike):
+    """Yield a temporary path next to ``path``; on success rename it over ``path``."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".part" + path.suffix, dir=path.parent)
+    os.close(fd)
+    try:
+        yield Path(tmp)
+        os.replace(tmp, path)
+    except BaseException:
+        with contextlib.suppress(FileNotFoundError):
+            os.unlink(tmp)
+        raise
+
+
+def write_bytes(path: str | os.PathLike, data: bytes) -> None:
+    with atomic_path(path) as tmp:
+        tmp.write_bytes(data)
+
+
+def write_text(path: str | os.PathLike, text: str) -> None:
+    write_bytes(path, text.encode("utf-8"))
+
+
+def to_uint8(image: np.ndarray) -> np.ndarray:
+    """Float image in [0, 1] (or already uint8) to uint8, rounding to nearest."""
+    if image.dtype == np.uint8:
+        return image
+    return np.clip(np.rint(np.asarray(image, dtype=np.float32) * 255.0), 0, 255).astype(np.uint8)
+
+
+def write_png(path: str | os.PathLike, image: np.ndarray) -> None:
+    """Write an (H, W), (H, W, 3) or (H, W, 4) image, float in [0, 1] or uint8, as PNG."""
+    with atomic_path(path) as tmp:
+        iio.imwrite(tmp, to_uint8(image), extension=".png")
+
+
+def write_npy(path: str | os.PathLike, array: np.ndarray) -> None:
+    with atomic_path(path) as tmp:
+        with open(tmp, "wb") as handle:
+            np.save(handle, array)
+
+
+def read_image(path: str | os.PathLike, *, channels: int | None = None) -> np.ndarray:
+    """Read an image file as float32 in [0, 1], shape (H, W, C).
+
+    ``channels`` (1, 3 or 4) converts: grey is repeated, alpha is dropped or set to 1.
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise InputError(f"{path}: no such file")
+    try:
+        data = iio.imread(path)
+    except Exception as exc:
+        raise InputError(f"{path}: not a readable image ({exc})") from None
+    if data.ndim == 2:
+        data = data[:, :, None]
+    if data.ndim != 3:
+        raise InputError(f"{path}: expected a single image, got an array of shape {data.shape}")
+    scale = float(np.iinfo(data.dtype).max) if np.issubdtype(data.dtype, np.integer) else 1.0
+    image = data.astype(np.float32) / np.float32(scale)
+    if channels is None:
+        return image
+    return _convert_channels(image, channels)
+
+
+def _convert_channels(image: np.ndarray, channels: int) -> np.ndarray:
+    have = image.shape[2]
+    if have == channels:
+        return image
+    colour = image[:, :, :1].repeat(3, axis=2) if have in (1, 2) else image[:, :, :3]
+    if channels == 1:
+        return colour.mean(axis=2, keepdims=True) if have >= 3 else image[:, :, :1]
+    if channels == 3:
+        return colour
+    alpha = image[:, :, 3:4] if have == 4 else image[:, :, 1:2] if have == 2 else np.ones_like(image[:, :, :1])
+    return np.concatenate([colour, alpha], axis=2)

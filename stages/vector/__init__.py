@@ -1,0 +1,1 @@
+"""Readers for vector animations: Lottie (.json/.lottie/.tgs), SVG (static, SMIL, sequences)."""
