@@ -1,0 +1,20 @@
+"""Shared fixtures."""
+
+import os
+
+import pytest
+
+os.environ.setdefault("NUMBA_NUM_THREADS", "2")
+
+
+@pytest.fixture
+def cli(capsys):
+    """Run ``fluidymation ARGS`` in-process; return (exit code, stdout, stderr)."""
+    from fluidymation.pipeline.cli import main
+
+    def run(*args):
+        code = main([str(a) for a in args])
+        out, err = capsys.readouterr()
+        return code, out, err
+
+    return run

@@ -1,0 +1,1 @@
+"""Slow, obvious reference versions of engine kernels, for tests on tiny inputs."""
