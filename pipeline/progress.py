@@ -1,0 +1,12 @@
+"""Progress bars on stderr: shown only for work that takes over a second, never with -q."""
+
+from __future__ import annotations
+
+import sys
+
+from tqdm import tqdm
+
+
+def progress(total: int, description: str, *, quiet: bool = False, unit: str = "frame") -> tqdm:
+    return tqdm(total=total, desc=description, unit=unit, file=sys.stderr, disable=quiet, delay=1.0,
+                dynamic_ncols=True, leave=False)

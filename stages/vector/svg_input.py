@@ -1,0 +1,162 @@
+"""Plain SVG: a static file (held over the frame range) or a numbered sequence of files.
+
+Layers are the top-level ``<g>`` elements of the root ``<svg>``, named by
+``inkscape:label`` or else ``id`` (``group N`` when neither is set). To render some layers
+alone, every other top-level drawable element is given ``display="none"``.
+"""
+
+from __future__ import annotations
+
+import copy
+import glob
+import re
+from pathlib import Path
+from xml.etree import ElementTree
+
+from fluidymation.errors import InputError
+from fluidymation.stages.vector.base import VectorLayer, VectorSource
+from fluidymation.stages.vector.raster import render_svg
+from fluidymation.stages.vector.safety import check_svg_references, local_name, parse_xml, read_file
+
+INKSCAPE_LABEL = "{http://www.inkscape.org/namespaces/inkscape}label"
+SVG_NAMESPACE = "http://www.w3.org/2000/svg"
+MAX_SEQUENCE_FILES = 100_000
+_NOT_DRAWN = {"defs", "style", "title", "desc", "metadata", "namedview", "script"}
+_SMIL_TAGS = {"animate", "animateTransform", "animateMotion", "animateColor", "set"}
+_UNITS_PX = {"": 1.0, "px": 1.0, "pt": 96 / 72, "pc": 16.0, "mm": 96 / 25.4, "cm": 96 / 2.54, "in": 96.0}
+_LENGTH = re.compile(r"^\s*([0-9.eE+-]+)\s*([a-z%]*)\s*$")
+
+
+def load_svg(path: Path) -> ElementTree.Element:
+    """Parse and vet an SVG file: well-formed, an <svg> root, no external references."""
+    root = parse_xml(read_file(path), str(path))
+    if local_name(root.tag) != "svg":
+        raise InputError(f"{path}: the root element is <{local_name(root.tag)}>, not <svg>")
+    check_svg_references(root, str(path))
+    return root
+
+
+def has_smil(root: ElementTree.Element) -> bool:
+    return any(local_name(element.tag) in _SMIL_TAGS for element in root.iter())
+
+
+def svg_size(root: ElementTree.Element, source: str) -> tuple[float, float]:
+    """The document size in px from width/height (with units) or the viewBox."""
+    box = (root.get("viewBox") or "").replace(",", " ").split()
+    sizes = []
+    for index, attribute in enumerate(("width", "height")):
+        value = _length_px(root.get(attribute))
+        if value is None and len(box) == 4:
+            value = _number(box[2 + index])
+        if value is None or value <= 0:
+            raise InputError(f"{source}: cannot tell the SVG's {attribute}: give the <svg> element a "
+                             "width/height or a viewBox, or set size in the scene")
+        sizes.append(value)
+    return sizes[0], sizes[1]
+
+
+def _length_px(text: str | None) -> float | None:
+    match = _LENGTH.match(text or "")
+    if not match or match.group(2) not in _UNITS_PX:
+        return None
+    value = _number(match.group(1))
+    return None if value is None else value * _UNITS_PX[match.group(2)]
+
+
+def _number(text: str) -> float | None:
+    try:
+        return float(text)
+    except ValueError:
+        return None
+
+
+def _layer_names(root: ElementTree.Element) -> list[str]:
+    names = []
+    for index, element in enumerate(_top_groups(root)):
+        names.append(element.get(INKSCAPE_LABEL) or element.get("id") or f"group {index}")
+    return names
+
+
+def _top_groups(root: ElementTree.Element) -> list[ElementTree.Element]:
+    return [element for element in root if local_name(element.tag) == "g"]
+
+
+def _isolated_svg(root: ElementTree.Element, names: list[str]) -> bytes:
+    root = copy.deepcopy(root)
+    keep = set(names)
+    groups = {id(element): name for element, name in zip(_top_groups(root), _layer_names(root))}
+    for element in root:
+        if local_name(element.tag) in _NOT_DRAWN:
+            continue
+        if groups.get(id(element)) not in keep:
+            element.set("display", "none")
+    ElementTree.register_namespace("", SVG_NAMESPACE)
+    return ElementTree.tostring(root)
+
+
+class SvgSource(VectorSource):
+    """A static SVG: the same picture on every frame."""
+
+    kind = "svg"
+    native_fps = None
+
+    def __init__(self, path: Path, root: ElementTree.Element):
+        self.path = path
+        self.root = root
+        self.width, self.height = svg_size(root, str(path))
+        self.layers = [VectorLayer(name, z) for z, name in enumerate(_layer_names(root))]
+
+    def default_range(self, fps):
+        return 0, 1
+
+    def render(self, names, frame, fps, size):
+        return render_svg(_isolated_svg(self.root, names), size, str(self.path))
+
+
+class SvgSequenceSource(VectorSource):
+    """Numbered SVG files, one per frame; layers are those of the first file."""
+
+    kind = "svg-sequence"
+    native_fps = None
+
+    def __init__(self, pattern: str, files: list[Path]):
+        self.path = Path(pattern)
+        self.files = files
+        first = load_svg(files[0])
+        self.width, self.height = svg_size(first, str(files[0]))
+        self.layers = [VectorLayer(name, z) for z, name in enumerate(_layer_names(first))]
+
+    def default_range(self, fps):
+        return 0, len(self.files)
+
+    def render(self, names, frame, fps, size):
+        if not 0 <= frame < len(self.files):
+            raise InputError(f"{self.path}: frame {frame} is outside the sequence (0 to {len(self.files) - 1})")
+        path = self.files[frame]
+        return render_svg(_isolated_svg(load_svg(path), names), size, str(path))
+
+
+def is_sequence_pattern(text: str) -> bool:
+    return bool(re.search(r"%0?\d*d", text)) or any(char in text for char in "*?[")
+
+
+def sequence_files(pattern: Path) -> list[Path]:
+    """Files of a ``frames/%04d.svg`` or glob pattern, in frame order."""
+    text = str(pattern)
+    printf = re.search(r"%(0?\d*)d", text)
+    if printf:
+        regex = re.compile(re.escape(text[: printf.start()]) + r"(\d+)" + re.escape(text[printf.end():]) + "$")
+        candidates = glob.glob(text[: printf.start()] + "*" + text[printf.end():])
+        numbered = sorted((int(m.group(1)), p) for p in candidates if (m := regex.match(p)))
+        files = [Path(p) for _, p in numbered]
+    else:
+        files = sorted((Path(p) for p in glob.glob(text)), key=_natural_key)
+    if not files:
+        raise InputError(f"{pattern}: no files match this sequence pattern")
+    if len(files) > MAX_SEQUENCE_FILES:
+        raise InputError(f"{pattern}: {len(files)} files is over the limit of {MAX_SEQUENCE_FILES} frames")
+    return files
+
+
+def _natural_key(path: Path):
+    return [int(part) if part.isdigit() else part for part in re.split(r"(\d+)", str(path))]
