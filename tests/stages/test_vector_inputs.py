@@ -1,0 +1,188 @@
+"""Vector inputs: exact geometry, and agreement with the lottie package's own rendering."""
+
+import copy
+import io
+import json
+from pathlib import Path
+
+import imageio.v3 as iio
+import lottie.objects
+import numpy as np
+import pytest
+from lottie.exporters.cairo import export_png
+
+from fluidymation.stages.vector import open_vector
+
+DATA = Path(__file__).parent.parent / "data" / "lottie"
+EXAMPLES = Path(__file__).parents[2] / "examples"
+
+
+def coverage(source, names, frame, size=None, fps=None):
+    fps = fps or source.native_fps or 24
+    size = size or (round(source.width), round(source.height))
+    return source.render(list(names), frame, fps, size)[:, :, 3] / 255.0
+
+
+def box(mask):
+    ys, xs = np.nonzero(mask)
+    return xs.min(), xs.max() + 1, ys.min(), ys.max() + 1
+
+
+def svg_circle(tmp_path, radius, size=200):
+    path = tmp_path / "circle.svg"
+    path.write_text(f'<svg xmlns="http://www.w3.org/2000/svg" width="{size}" height="{size}">'
+                    f'<g id="disc"><circle cx="{size / 2}" cy="{size / 2}" r="{radius}" fill="#123456"/></g></svg>')
+    return path
+
+
+@pytest.mark.parametrize("radius", [7.5, 20, 61])
+def test_svg_circle_covers_pi_r_squared(tmp_path, radius):
+    source = open_vector(svg_circle(tmp_path, radius))
+    area = coverage(source, ["disc"], 0).sum()
+    assert area == pytest.approx(np.pi * radius**2, rel=0.01)
+
+
+def test_circle_area_scales_with_output_size(tmp_path):
+    source = open_vector(svg_circle(tmp_path, 20, size=100))
+    area = coverage(source, ["disc"], 0, size=(300, 300)).sum()
+    assert area == pytest.approx(np.pi * 60**2, rel=0.01)
+
+
+def test_lottie_circle_area_and_keyframed_position():
+    source = open_vector(DATA / "shapes_keyframe.json")
+    assert coverage(source, ["disc"], 0).sum() == pytest.approx(np.pi * 20**2, rel=0.01)
+    assert box(coverage(source, ["square"], 0) >= 0.5) == (10, 30, 10, 30)
+    assert box(coverage(source, ["square"], 5) >= 0.5) == (38, 58, 10, 30)
+    assert box(coverage(source, ["square"], 11) >= 0.5) == (66, 86, 10, 30)
+
+
+def test_lottie_keyframe_follows_scene_fps():
+    source = open_vector(DATA / "shapes_keyframe.json")  # 12 fps file
+    assert box(coverage(source, ["square"], 10, fps=24) >= 0.5) == (38, 58, 10, 30)  # 24 fps frame 10 = 12 fps frame 5
+
+
+def test_parented_layer_moves_with_its_parents():
+    source = open_vector(DATA / "parenting.json")
+    assert box(coverage(source, ["head"], 5) >= 0.5) == (44, 60, 23, 39)
+    assert box(coverage(source, ["torso"], 5) >= 0.5) == (42, 62, 41, 71)
+    assert coverage(source, ["head"], 5)[60, 52] == 0  # the torso is not drawn with the head
+
+
+def test_trim_path_draws_on():
+    source = open_vector(DATA / "trim_path.json")
+    assert coverage(source, ["line"], 0).sum() < 1
+    assert box(coverage(source, ["line"], 5) >= 0.5) == (16, 48, 44, 52)
+    assert box(coverage(source, ["line"], 10) >= 0.5) == (16, 80, 44, 52)
+
+
+def test_track_matte_is_applied_and_matte_source_is_not_drawn():
+    source = open_vector(DATA / "matte.json")
+    stripes = coverage(source, ["stripes"], 0) >= 0.5
+    assert box(stripes) == (24, 72, 24, 72)
+    assert stripes.sum() == pytest.approx(np.pi * 24**2, rel=0.02)
+
+
+def test_precomp_is_one_layer_unless_split():
+    whole = open_vector(DATA / "precomp.json")
+    assert whole.layer_names() == ["ground", "leaves"]
+    split = open_vector(DATA / "precomp.json", split=("leaves",))
+    assert split.layer_names() == ["ground", "leaves/leaf_b", "leaves/leaf_a"]
+    leaf_a = coverage(split, ["leaves/leaf_a"], 0) >= 0.5
+    assert box(leaf_a) == (24, 56, 56, 88)
+    both = coverage(whole, ["leaves"], 0) >= 0.5
+    assert (both & leaf_a).sum() == leaf_a.sum() and both.sum() > leaf_a.sum() * 1.5
+
+
+def test_packed_forms_match_plain_json():
+    plain = open_vector(DATA / "parenting.json")
+    tgs = open_vector(DATA / "parenting.tgs")
+    assert np.array_equal(coverage(plain, ["head"], 5), coverage(tgs, ["head"], 5))
+    dot = open_vector(DATA / "precomp.lottie")
+    assert np.array_equal(coverage(open_vector(DATA / "precomp.json"), ["ground"], 3), coverage(dot, ["ground"], 3))
+
+
+def test_svg_layers_are_top_level_groups_by_label_then_id(tmp_path):
+    path = tmp_path / "two.svg"
+    path.write_text('<svg xmlns="http://www.w3.org/2000/svg" xmlns:inkscape="http://www.inkscape.org/namespaces/inkscape"'
+                    ' width="40" height="20"><rect width="40" height="20" fill="#fff"/>'
+                    '<g id="g1" inkscape:label="Left"><rect width="20" height="20" fill="#f00"/></g>'
+                    '<g id="right"><rect x="20" width="20" height="20" fill="#00f"/></g></svg>')
+    source = open_vector(path)
+    assert source.layer_names() == ["Left", "right"]
+    assert coverage(source, ["Left"], 0).sum() == pytest.approx(400)
+    assert coverage(source, ["Left", "right"], 0).sum() == pytest.approx(800)  # the background rect is no layer
+
+
+def test_svg_sequence_in_numeric_order(tmp_path):
+    for index in (0, 1, 2, 10):
+        (tmp_path / f"f{index}.svg").write_text(
+            f'<svg xmlns="http://www.w3.org/2000/svg" width="40" height="10"><g id="bar">'
+            f'<rect width="{index + 1}" height="10"/></g></svg>')
+    source = open_vector(tmp_path / "f%d.svg")
+    assert source.default_range(24) == (0, 4)
+    assert [coverage(source, ["bar"], f).sum() for f in range(4)] == pytest.approx([10, 20, 30, 110])
+
+
+def test_smil_example_grows():
+    source = open_vector(EXAMPLES / "blob" / "blob.svg")
+    areas = [coverage(source, ["blob"], frame, size=(64, 64), fps=24).sum() for frame in (0, 24)]
+    assert areas[1] > areas[0] * 1.2
+
+
+# --- agreement with the lottie package's own rendering of a layer alone -------------------
+
+def lottie_reference(path, layer_name, frame):
+    """The layer rendered by lottie's own PNG exporter, other layers removed or emptied."""
+    data = json.loads(path.read_text())
+    keep = _needed_layers(data["layers"], layer_name)
+    animation = lottie.objects.Animation.load(data)
+    for layer in list(animation.layers):
+        if layer.name == layer_name or layer.index in keep["matte"]:
+            continue
+        if layer.index in keep["parents"]:
+            if hasattr(layer, "shapes"):
+                layer.shapes = []
+        else:
+            animation.layers.remove(layer)
+    buffer = io.BytesIO()
+    export_png(animation, buffer, frame)
+    return iio.imread(buffer.getvalue())[:, :, 3] / 255.0
+
+
+def _needed_layers(layers, name):
+    by_index = {layer.get("ind"): layer for layer in layers}
+    target = next(layer for layer in layers if layer.get("nm") == name)
+    parents, parent = set(), target.get("parent")
+    while parent is not None:
+        parents.add(parent)
+        parent = by_index[parent].get("parent")
+    position = layers.index(target)
+    matte = {layers[position - 1].get("ind")} if target.get("tt") and position else set()
+    return {"parents": parents, "matte": matte}
+
+
+CASES = [("shapes_keyframe.json", "square"), ("shapes_keyframe.json", "disc"), ("parenting.json", "head"),
+         ("parenting.json", "torso"), ("precomp.json", "leaves"), ("precomp.json", "ground"),
+         ("trim_path.json", "line"), ("mask.json", "masked_square"), ("matte.json", "stripes")]
+
+
+@pytest.mark.parametrize("filename,layer", CASES)
+def test_masks_agree_with_lottie_rendering(filename, layer):
+    source = open_vector(DATA / filename)
+    for frame in (0, 5, 11):
+        ours = coverage(source, [layer], frame) >= 0.5
+        reference = lottie_reference(DATA / filename, layer, frame) >= 0.5
+        union = (ours | reference).sum()
+        if union == 0:
+            continue
+        assert (ours & reference).sum() / union >= 0.99, (filename, layer, frame)
+
+
+@pytest.mark.parametrize("layer", ["body", "arm"])
+def test_wave_example_agrees_with_lottie_rendering(layer):
+    path = EXAMPLES / "wave" / "wave.json"
+    source = open_vector(path)
+    for frame in (0, 12, 30):
+        ours = coverage(source, [layer], frame) >= 0.5
+        reference = lottie_reference(path, layer, frame) >= 0.5
+        assert (ours & reference).sum() / (ours | reference).sum() >= 0.99
