@@ -1,0 +1,506 @@
+"""Generalized PatchMatch over (source frame, x, y, θ) with a pluggable patch cost.
+
+The patch cost of matching target pixel q to source patch ``(i, x, y, θ)`` is a sum over
+the n×n window of
+
+* a weighted SSD of features (colour first, then guides). Features are stored already
+  multiplied by the square root of their weight, so the kernel sums plain squared
+  differences; features may further be scaled per target pixel by a weight map (e.g.
+  the temporal modulation m(q)), evaluated at the window's target pixel;
+* optionally ``w_dir · min(|tan(S_dir + θ − T_dir)|, clamp)`` (orientation term);
+* optionally, when source and target flows point roughly opposite ways
+  (``cos(S_dir(p) + θ − T_dir(q)) < 0`` at the centres), a permutation of the source
+  features (e.g. swap ext+ and ext−),
+
+plus, in the search, a per-candidate uniformity penalty looked up in a map over the
+source (:mod:`fluidymation.engine.uniformity`). Summation stops early once the partial
+sum exceeds the current best. A target pixel only matches source patches whose centre
+has the same segment label; pixels labelled -1 are not synthesized.
+
+Parallelism: the target is cut into fixed bands of rows (tiles), processed in parallel.
+Inside a tile, propagation reads the live field; across a tile border it reads the
+field as it was at the start of the pass (one-pass-delayed propagation), so results are
+the same for any number of threads.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+
+import numpy as np
+from numba import prange
+
+from fluidymation.engine._jit import kernel, parallel_kernel
+from fluidymation.engine.nnf import ROTATION_FLOW, _flow_rotation
+from fluidymation.engine.random import _key4, _random_below
+from fluidymation.engine.sampling import _bilinear_setup
+
+TILE_ROWS = 16
+_INF = np.float32(np.inf)
+
+
+@kernel
+def _patch_cost(
+    source, target, feature_start, plain_end, group_ends, weight_maps, opposite_feature,
+    source_angle, target_angle, orientation_weight, orientation_clamp, use_opposite,
+    radius, tx, ty, frame, x, y, theta, bound,
+):
+    height = target.shape[0]
+    width = target.shape[1]
+    source_height = source.shape[1]
+    source_width = source.shape[2]
+    groups = group_ends.shape[0]
+    opposite = False
+    if use_opposite:
+        centre_angle = source_angle[frame, int(y + 0.5), int(x + 0.5)]
+        opposite = math.cos(centre_angle + theta - target_angle[ty, tx]) < 0.0
+    total = np.float32(0.0)
+    sx = int(x)
+    sy = int(y)
+    if (
+        theta == 0.0 and x == sx and y == sy and not opposite and orientation_weight == 0.0
+        and radius <= sx < source_width - radius and radius <= sy < source_height - radius
+    ):
+        for dy in range(-radius, radius + 1):
+            qy = ty + dy
+            if qy < 0 or qy >= height:
+                continue
+            py = sy + dy
+            for dx in range(-radius, radius + 1):
+                qx = tx + dx
+                if qx < 0 or qx >= width:
+                    continue
+                px = sx + dx
+                for c in range(feature_start, plain_end):
+                    d = source[frame, py, px, c] - target[qy, qx, c]
+                    total += d * d
+                start = plain_end
+                for g in range(groups):
+                    part = np.float32(0.0)
+                    for c in range(max(start, feature_start), group_ends[g]):
+                        d = source[frame, py, px, c] - target[qy, qx, c]
+                        part += d * d
+                    total += weight_maps[g, qy, qx] * part
+                    start = group_ends[g]
+            if total > bound:
+                return total
+        return total
+    cos_t = math.cos(theta)
+    sin_t = math.sin(theta)
+    for dy in range(-radius, radius + 1):
+        qy = ty + dy
+        if qy < 0 or qy >= height:
+            continue
+        for dx in range(-radius, radius + 1):
+            qx = tx + dx
+            if qx < 0 or qx >= width:
+                continue
+            sample_x = x + cos_t * dx - sin_t * dy
+            sample_y = y + sin_t * dx + cos_t * dy
+            x0, y0, x1, y1, w00, w10, w01, w11 = _bilinear_setup(sample_x, sample_y, source_height, source_width)
+            start = feature_start
+            for g in range(-1, groups):
+                end = plain_end if g < 0 else group_ends[g]
+                part = np.float32(0.0)
+                for c in range(start, end):
+                    sc = opposite_feature[c] if opposite else c
+                    value = (
+                        w00 * source[frame, y0, x0, sc]
+                        + w10 * source[frame, y0, x1, sc]
+                        + w01 * source[frame, y1, x0, sc]
+                        + w11 * source[frame, y1, x1, sc]
+                    )
+                    d = value - target[qy, qx, c]
+                    part += d * d
+                total += part if g < 0 else weight_maps[g, qy, qx] * part
+                start = max(end, feature_start)
+            if orientation_weight > 0.0:
+                nearest_x = int(min(max(sample_x + 0.5, 0.0), source_width - 1.0))
+                nearest_y = int(min(max(sample_y + 0.5, 0.0), source_height - 1.0))
+                turn = source_angle[frame, nearest_y, nearest_x] + theta - target_angle[qy, qx]
+                total += orientation_weight * min(abs(math.tan(turn)), orientation_clamp)
+        if total > bound:
+            return total
+    return total
+
+
+@parallel_kernel
+def _evaluate(
+    source, target, feature_start, plain_end, group_ends, weight_maps, opposite_feature,
+    source_angle, target_angle, orientation_weight, orientation_clamp, use_opposite, radius,
+    nnf_frame, nnf_coords, out,
+):
+    height, width = nnf_frame.shape
+    for ty in prange(height):
+        for tx in range(width):
+            frame = nnf_frame[ty, tx]
+            if frame < 0:
+                out[ty, tx] = np.inf
+                continue
+            out[ty, tx] = _patch_cost(
+                source, target, feature_start, plain_end, group_ends, weight_maps, opposite_feature,
+                source_angle, target_angle, orientation_weight, orientation_clamp, use_opposite, radius,
+                tx, ty, frame, nnf_coords[ty, tx, 0], nnf_coords[ty, tx, 1], nnf_coords[ty, tx, 2], np.inf,
+            )
+
+
+@kernel
+def _penalty_at(penalty, use_penalty, frame, x, y):
+    if not use_penalty:
+        return np.float32(0.0)
+    return penalty[frame, int(y + 0.5), int(x + 0.5)]
+
+
+@parallel_kernel
+def _search(
+    source, target, feature_start, plain_end, group_ends, weight_maps, opposite_feature,
+    source_angle, target_angle, orientation_weight, orientation_clamp, use_opposite, radius,
+    source_segment, target_segment, penalty, use_penalty,
+    nnf_frame, nnf_coords, error, start_frame, start_coords,
+    rotation_mode, alpha, seed, salt, reverse, tile_rows,
+):
+    height, width = nnf_frame.shape
+    frames, source_height, source_width = source_segment.shape
+    high_x = np.float32(source_width - 1)
+    high_y = np.float32(source_height - 1)
+    longest = max(source_width, source_height)
+    step = -1 if reverse else 1
+    tiles = (height + tile_rows - 1) // tile_rows
+    for tile in prange(tiles):
+        y_begin = tile * tile_rows
+        y_end = min(height, y_begin + tile_rows)
+        for row in range(y_end - y_begin):
+            ty = y_end - 1 - row if reverse else y_begin + row
+            for column in range(width):
+                tx = width - 1 - column if reverse else column
+                label = target_segment[ty, tx]
+                best_frame = nnf_frame[ty, tx]
+                if label < 0 or best_frame < 0:
+                    continue
+                best_x = nnf_coords[ty, tx, 0]
+                best_y = nnf_coords[ty, tx, 1]
+                best_theta = nnf_coords[ty, tx, 2]
+                best_error = error[ty, tx]
+                best_total = best_error + _penalty_at(penalty, use_penalty, best_frame, best_x, best_y)
+                # propagation: the neighbour's patch, shifted by the offset turned by its θ
+                for direction in range(2):
+                    nx = tx - step if direction == 0 else tx
+                    ny = ty if direction == 0 else ty - step
+                    if nx < 0 or nx >= width or ny < 0 or ny >= height:
+                        continue
+                    if y_begin <= ny < y_end:
+                        cand_frame = nnf_frame[ny, nx]
+                        cx = nnf_coords[ny, nx, 0]
+                        cy = nnf_coords[ny, nx, 1]
+                        cand_theta = nnf_coords[ny, nx, 2]
+                    else:
+                        cand_frame = start_frame[ny, nx]
+                        cx = start_coords[ny, nx, 0]
+                        cy = start_coords[ny, nx, 1]
+                        cand_theta = start_coords[ny, nx, 2]
+                    if cand_frame < 0:
+                        continue
+                    ex = np.float32(tx - nx)
+                    ey = np.float32(ty - ny)
+                    if cand_theta != 0.0:
+                        cos_t = math.cos(cand_theta)
+                        sin_t = math.sin(cand_theta)
+                        cx += cos_t * ex - sin_t * ey
+                        cy += sin_t * ex + cos_t * ey
+                    else:
+                        cx += ex
+                        cy += ey
+                    cx = min(max(cx, np.float32(0.0)), high_x)
+                    cy = min(max(cy, np.float32(0.0)), high_y)
+                    if cand_frame == best_frame and cx == best_x and cy == best_y and cand_theta == best_theta:
+                        continue
+                    if source_segment[cand_frame, int(cy + 0.5), int(cx + 0.5)] != label:
+                        continue
+                    cand_penalty = _penalty_at(penalty, use_penalty, cand_frame, cx, cy)
+                    if cand_penalty >= best_total:
+                        continue
+                    cand_error = _patch_cost(
+                        source, target, feature_start, plain_end, group_ends, weight_maps, opposite_feature,
+                        source_angle, target_angle, orientation_weight, orientation_clamp, use_opposite, radius,
+                        tx, ty, cand_frame, cx, cy, cand_theta, best_total - cand_penalty,
+                    )
+                    if cand_error + cand_penalty < best_total:
+                        best_frame = cand_frame
+                        best_x = cx
+                        best_y = cy
+                        best_theta = cand_theta
+                        best_error = cand_error
+                        best_total = cand_error + cand_penalty
+                # random search in shrinking boxes over (frame, x, y)
+                key = _key4(seed, salt, ty, tx)
+                draw = 0
+                scale = 1.0
+                while scale * longest >= 1.0:
+                    half_x = scale * source_width
+                    half_y = scale * source_height
+                    half_t = int(scale * frames)
+                    centre_x = int(best_x + 0.5)
+                    centre_y = int(best_y + 0.5)
+                    x_lo = max(0, int(centre_x - half_x))
+                    x_hi = min(source_width - 1, int(centre_x + half_x))
+                    y_lo = max(0, int(centre_y - half_y))
+                    y_hi = min(source_height - 1, int(centre_y + half_y))
+                    f_lo = max(0, best_frame - half_t)
+                    f_hi = min(frames - 1, best_frame + half_t)
+                    cx_int = x_lo + _random_below(key, draw, x_hi - x_lo + 1)
+                    cy_int = y_lo + _random_below(key, draw + 1, y_hi - y_lo + 1)
+                    cand_frame = f_lo + _random_below(key, draw + 2, f_hi - f_lo + 1)
+                    draw += 3
+                    scale *= alpha
+                    if source_segment[cand_frame, cy_int, cx_int] != label:
+                        continue
+                    cx = np.float32(cx_int)
+                    cy = np.float32(cy_int)
+                    cand_penalty = _penalty_at(penalty, use_penalty, cand_frame, cx, cy)
+                    if cand_penalty >= best_total:
+                        continue
+                    rotations = 2 if rotation_mode == ROTATION_FLOW else 1
+                    for flip in range(rotations):
+                        cand_theta = np.float32(0.0)
+                        if rotation_mode == ROTATION_FLOW:
+                            cand_theta = np.float32(
+                                _flow_rotation(target_angle, source_angle, cand_frame, cx, cy, tx, ty, flip == 1)
+                            )
+                        cand_error = _patch_cost(
+                            source, target, feature_start, plain_end, group_ends, weight_maps, opposite_feature,
+                            source_angle, target_angle, orientation_weight, orientation_clamp, use_opposite, radius,
+                            tx, ty, cand_frame, cx, cy, cand_theta, best_total - cand_penalty,
+                        )
+                        if cand_error + cand_penalty < best_total:
+                            best_frame = cand_frame
+                            best_x = cx
+                            best_y = cy
+                            best_theta = cand_theta
+                            best_error = cand_error
+                            best_total = cand_error + cand_penalty
+                nnf_frame[ty, tx] = best_frame
+                nnf_coords[ty, tx, 0] = best_x
+                nnf_coords[ty, tx, 1] = best_y
+                nnf_coords[ty, tx, 2] = best_theta
+                error[ty, tx] = best_error
+
+
+@dataclass(frozen=True)
+class PatchCost:
+    """Kernel-ready description of the patch distance at one pyramid level.
+
+    Build it with :func:`build_patch_cost`. Features are ordered: colour, guides without
+    a weight map, then guides grouped by weight map; all are pre-multiplied by
+    ``sqrt(weight)``.
+
+    Attributes
+    ----------
+    source_features : ndarray, shape (T, Hs, Ws, F), float32
+    target_features : ndarray, shape (H, W, F), float32
+        Its first ``colour_channels`` features are rewritten after every vote.
+    colour_scale : ndarray, shape (Cc,), float32
+        ``sqrt`` of the colour weights.
+    plain_end : int
+        Features ``[0, plain_end)`` have no per-pixel weight map.
+    group_ends : ndarray, shape (M,), int64
+        Map m weighs features ``[group_ends[m-1] (or plain_end), group_ends[m])``.
+    weight_maps : ndarray, shape (M, H, W), float32
+    opposite_feature : ndarray, shape (F,), int64
+        Source feature compared with target feature f when the flows are opposite.
+    use_opposite : bool
+    source_angle, target_angle : ndarray, (T, Hs, Ws) and (H, W), float32
+        Flow orientations (radians); 1-pixel placeholders when unused.
+    orientation_weight, orientation_clamp : float
+    source_segment : ndarray, shape (T, Hs, Ws), int32
+    target_segment : ndarray, shape (H, W), int32
+    patch_size : int
+    feature_start : int
+        First feature summed (``colour_channels`` for a guides-only pass).
+    """
+
+    source_features: np.ndarray
+    target_features: np.ndarray
+    colour_scale: np.ndarray
+    plain_end: int
+    group_ends: np.ndarray
+    weight_maps: np.ndarray
+    opposite_feature: np.ndarray
+    use_opposite: bool
+    source_angle: np.ndarray
+    target_angle: np.ndarray
+    orientation_weight: float
+    orientation_clamp: float
+    source_segment: np.ndarray
+    target_segment: np.ndarray
+    patch_size: int
+    feature_start: int = 0
+
+    @property
+    def colour_channels(self):
+        return self.colour_scale.shape[0]
+
+    def guides_only(self):
+        """The same cost with the colour features left out."""
+        return replace(self, feature_start=self.colour_channels)
+
+    def set_target_colour(self, colour):
+        """Store the current target colour (H, W, Cc) float32 into the target features."""
+        np.multiply(colour, self.colour_scale, out=self.target_features[:, :, : self.colour_channels])
+
+    def kernel_args(self):
+        return (
+            self.source_features, self.target_features, self.feature_start, self.plain_end, self.group_ends,
+            self.weight_maps, self.opposite_feature, self.source_angle, self.target_angle,
+            np.float32(self.orientation_weight), np.float32(self.orientation_clamp), self.use_opposite,
+            self.patch_size // 2,
+        )
+
+
+def build_patch_cost(*, source_colour, source_guides, target_colour, target_guides, colour_weights, guide_weights,
+                     guide_weight_map=None, weight_maps=None, opposite_guide=None, source_angle=None,
+                     target_angle=None, orientation_weight=0.0, orientation_clamp=10.0, source_segment=None,
+                     target_segment=None, patch_size=5):
+    """Assemble a :class:`PatchCost` from colour and guide channels.
+
+    Parameters
+    ----------
+    source_colour : ndarray, shape (T, Hs, Ws, Cc), float32
+    source_guides : ndarray, shape (T, Hs, Ws, G), float32
+    target_colour : ndarray, shape (H, W, Cc), float32
+        The current synthesized colour.
+    target_guides : ndarray, shape (H, W, G), float32
+    colour_weights : array-like, shape (Cc,)
+    guide_weights : array-like, shape (G,)
+        Non-negative weights.
+    guide_weight_map : array-like of int, shape (G,), optional
+        Index into ``weight_maps`` per guide channel, -1 for none.
+    weight_maps : ndarray, shape (M, H, W), float32, optional
+        Per-target-pixel weight multipliers.
+    opposite_guide : array-like of int, shape (G,), optional
+        Source guide channel compared with guide g when flows are opposite
+        (requires the angles).
+    source_angle, target_angle : ndarray, (T, Hs, Ws) and (H, W), float32, optional
+        Flow orientations in radians.
+    orientation_weight, orientation_clamp : float
+        Weight and clamp of the ``|tan|`` orientation term.
+    source_segment, target_segment : ndarray of int, optional
+        Segment labels (default: all 0).
+    patch_size : int
+
+    Returns
+    -------
+    PatchCost
+    """
+    source_colour = np.asarray(source_colour, np.float32)
+    source_guides = np.asarray(source_guides, np.float32)
+    target_guides = np.asarray(target_guides, np.float32)
+    frames, source_height, source_width, colours = source_colour.shape
+    guides = source_guides.shape[3]
+    height, width = target_guides.shape[:2]
+    colour_weights = np.asarray(colour_weights, np.float32).reshape(colours)
+    guide_weights = np.asarray(guide_weights, np.float32).reshape(guides)
+    if (colour_weights < 0).any() or (guide_weights < 0).any():
+        raise ValueError("weights must be non-negative")
+    if guide_weight_map is None:
+        guide_weight_map = np.full(guides, -1, np.int64)
+    guide_weight_map = np.asarray(guide_weight_map, np.int64).reshape(guides)
+    maps = 0 if weight_maps is None else weight_maps.shape[0]
+    if guide_weight_map.max(initial=-1) >= maps:
+        raise ValueError(f"guide_weight_map refers to map {guide_weight_map.max()} but {maps} weight maps were given")
+    # order guides: no map first, then by map index (stable)
+    order = np.argsort(np.where(guide_weight_map < 0, -1, guide_weight_map), kind="stable")
+    position = np.empty(guides, np.int64)
+    position[order] = np.arange(guides)
+    group_ends = np.array([colours + np.count_nonzero(guide_weight_map <= m) for m in range(maps)], np.int64)
+    plain_end = colours + int(np.count_nonzero(guide_weight_map < 0))
+    guide_scale = np.sqrt(guide_weights)[order]
+    colour_scale = np.sqrt(colour_weights)
+    source_features = np.empty((frames, source_height, source_width, colours + guides), np.float32)
+    np.multiply(source_colour, colour_scale, out=source_features[..., :colours])
+    np.multiply(source_guides[..., order], guide_scale, out=source_features[..., colours:])
+    target_features = np.empty((height, width, colours + guides), np.float32)
+    np.multiply(target_guides[..., order], guide_scale, out=target_features[..., colours:])
+    target_features[..., :colours] = np.asarray(target_colour, np.float32) * colour_scale
+    opposite_feature = np.arange(colours + guides, dtype=np.int64)
+    use_opposite = opposite_guide is not None
+    if use_opposite:
+        opposite_guide = np.asarray(opposite_guide, np.int64).reshape(guides)
+        opposite_feature[colours + position] = colours + position[opposite_guide]
+    needs_angles = use_opposite or orientation_weight > 0
+    if needs_angles and (source_angle is None or target_angle is None):
+        raise ValueError("the orientation term and opposite-flow swapping need source_angle and target_angle")
+    if source_angle is None:
+        source_angle = np.zeros((1, 1, 1), np.float32)
+        target_angle = np.zeros((1, 1), np.float32)
+    if source_segment is None:
+        source_segment = np.zeros((frames, source_height, source_width), np.int32)
+    if target_segment is None:
+        target_segment = np.zeros((height, width), np.int32)
+    if weight_maps is None:
+        weight_maps = np.zeros((0, height, width), np.float32)
+    return PatchCost(
+        source_features=source_features,
+        target_features=target_features,
+        colour_scale=colour_scale,
+        plain_end=plain_end,
+        group_ends=group_ends,
+        weight_maps=np.ascontiguousarray(weight_maps, np.float32),
+        opposite_feature=opposite_feature,
+        use_opposite=use_opposite,
+        source_angle=np.ascontiguousarray(source_angle, np.float32),
+        target_angle=np.ascontiguousarray(target_angle, np.float32),
+        orientation_weight=float(orientation_weight),
+        orientation_clamp=float(orientation_clamp),
+        source_segment=np.ascontiguousarray(source_segment, np.int32),
+        target_segment=np.ascontiguousarray(target_segment, np.int32),
+        patch_size=int(patch_size),
+    )
+
+
+def patch_errors(cost, nnf):
+    """Patch cost (without the uniformity penalty) of every match of ``nnf``.
+
+    Returns
+    -------
+    ndarray, shape (H, W), float32; ``inf`` where the NNF has no match.
+    """
+    out = np.empty(nnf.shape, np.float32)
+    _evaluate(*cost.kernel_args(), nnf.frame, nnf.coords, out)
+    return out
+
+
+def patchmatch_pass(cost, nnf, error, *, penalty=None, rotation_mode=0, alpha=0.75, seed=0, salt=0,
+                    reverse=False, tile_rows=TILE_ROWS):
+    """One PatchMatch iteration (propagation, then random search), in place.
+
+    Parameters
+    ----------
+    cost : PatchCost
+    nnf : NNF
+        Modified in place.
+    error : ndarray, shape (H, W), float32
+        :func:`patch_errors` of ``nnf`` under ``cost``; kept up to date in place.
+    penalty : ndarray, shape (T, Hs, Ws), float32, optional
+        Uniformity cost of a patch centred at each source voxel.
+    rotation_mode : int
+        ``ROTATION_NONE`` or ``ROTATION_FLOW`` (the two flow-aligned angles).
+    alpha : float
+        Shrink factor of the random-search box (0 < alpha < 1).
+    seed, salt : int
+        Random numbers come from ``(seed, salt, y, x)``; give each pass its own salt.
+    reverse : bool
+        Scan right-to-left, bottom-to-top and propagate from the right/bottom.
+    tile_rows : int
+        Height of the fixed tiles; the result depends on it, not on the thread count.
+    """
+    if not 0.0 < alpha < 1.0:
+        raise ValueError(f"alpha must lie in (0, 1), got {alpha}")
+    use_penalty = penalty is not None
+    if penalty is None:
+        penalty = np.zeros((1, 1, 1), np.float32)
+    _search(
+        *cost.kernel_args(), cost.source_segment, cost.target_segment, penalty, use_penalty,
+        nnf.frame, nnf.coords, error, nnf.frame.copy(), nnf.coords.copy(),
+        int(rotation_mode), float(alpha), int(seed), int(salt), bool(reverse), int(tile_rows),
+    )

@@ -1,0 +1,324 @@
+"""Multi-scale guided patch synthesis: the driver that every stylizer calls.
+
+For each pyramid level, coarsest first: initialise the NNF (random, or upscaled from the
+coarser level, optionally merged per pixel with a supplied NNF downscaled to the level),
+vote, then repeat ``search_vote_iters`` times: PatchMatch (``patchmatch_iters`` passes,
+the uniformity map recomputed before each pass) and vote. Per-level schedules are given
+coarsest first; the last value repeats for the finer levels.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from fluidymation.engine.nnf import (
+    NNF, ROTATION_FLOW, ROTATION_NONE, downscale_nnf, fill_random, merge_nnf, segment_index, upscale_nnf,
+)
+from fluidymation.engine.patchmatch import TILE_ROWS, build_patch_cost, patch_errors, patchmatch_pass
+from fluidymation.engine.pyramid import (
+    downsample, downsample_angles, downsample_labels, gaussian_pyramid, levels_that_fit,
+)
+from fluidymation.engine.uniformity import budget_scales, occurrence_map, uniformity_penalty
+from fluidymation.engine.vote import vote
+
+_ROTATIONS = {"none": ROTATION_NONE, "flow": ROTATION_FLOW}
+
+
+@dataclass(frozen=True)
+class SynthesisParams:
+    """Options of :func:`synthesize`.
+
+    Attributes
+    ----------
+    patch_size : int
+        Odd patch side n.
+    pyramid_levels : int or None
+        Level count; None (or more than fit) uses as many as keep the coarsest level's
+        sides ≥ 2n + 1.
+    search_vote_iters, patchmatch_iters : tuple of int
+        Per level, coarsest first; the last value repeats.
+    vote_only_finest : bool
+        Do not optimise the finest level: only vote the upscaled NNF (when > 1 level).
+    guided_initialization : bool
+        After a random start, run one PatchMatch with the colour weight 0 (guides only).
+    alpha : float
+        Shrink factor of the random-search boxes.
+    uniformity_weight : float
+        λ of the uniformity penalty (0 disables it), in the squared units of the features.
+    uniformity_radius : int
+        r: a patch also occupies the r frames before and after its own.
+    orientation_weight, orientation_clamp : float
+        Weight and clamp of the ``|tan(S_dir + θ − T_dir)|`` term (needs the angles).
+    rotation : {"none", "flow"}
+        θ = 0, or the two flow-aligned angles θ_T − θ_S and θ_T − θ_S + π.
+    seed : int
+    tile_rows : int
+        Height of the fixed parallel tiles.
+    """
+
+    patch_size: int = 5
+    pyramid_levels: int | None = None
+    search_vote_iters: tuple = (6,)
+    patchmatch_iters: tuple = (4,)
+    vote_only_finest: bool = False
+    guided_initialization: bool = False
+    alpha: float = 0.75
+    uniformity_weight: float = 0.0
+    uniformity_radius: int = 0
+    orientation_weight: float = 0.0
+    orientation_clamp: float = 10.0
+    rotation: str = "none"
+    seed: int = 0
+    tile_rows: int = TILE_ROWS
+
+    def __post_init__(self):
+        if self.patch_size < 3 or self.patch_size % 2 == 0:
+            raise ValueError(f"patch_size must be an odd number ≥ 3, got {self.patch_size}")
+        if self.pyramid_levels is not None and self.pyramid_levels < 1:
+            raise ValueError(f"pyramid_levels must be ≥ 1, got {self.pyramid_levels}")
+        for name in ("search_vote_iters", "patchmatch_iters"):
+            value = tuple(getattr(self, name))
+            if not value or min(value) < 0:
+                raise ValueError(f"{name} must be a non-empty sequence of counts ≥ 0, got {value}")
+            object.__setattr__(self, name, value)
+        if not 0.0 < self.alpha < 1.0:
+            raise ValueError(f"alpha must lie in (0, 1), got {self.alpha}")
+        if self.uniformity_weight < 0 or self.uniformity_radius < 0 or self.orientation_weight < 0:
+            raise ValueError("uniformity_weight, uniformity_radius and orientation_weight must be ≥ 0")
+        if self.rotation not in _ROTATIONS:
+            raise ValueError(f"rotation must be one of {sorted(_ROTATIONS)}, got {self.rotation!r}")
+        if self.seed < 0 or self.tile_rows < 1:
+            raise ValueError("seed must be ≥ 0 and tile_rows ≥ 1")
+
+
+@dataclass(frozen=True)
+class SynthesisInputs:
+    """Source sequence, target guides and everything the patch cost compares.
+
+    Attributes
+    ----------
+    source_colour : ndarray, shape (T, Hs, Ws, Cc), float32
+        What is synthesized (and compared with the current target colour).
+    source_guides : ndarray, shape (T, Hs, Ws, G), float32
+    target_guides : ndarray, shape (H, W, G), float32
+    colour_weights : ndarray, shape (Cc,)
+    guide_weights : ndarray, shape (G,)
+    weight_maps : ndarray, shape (M, H, W), float32, optional
+        Per-target-pixel multipliers, e.g. the temporal modulation m(q).
+    guide_weight_map : ndarray of int, shape (G,), optional
+        Which weight map scales each guide channel (-1: none).
+    opposite_guide : ndarray of int, shape (G,), optional
+        Source guide compared with guide g where source and target flows are opposite.
+    source_angle, target_angle : ndarray, (T, Hs, Ws) and (H, W), float32, optional
+        Flow orientations (radians) for ``rotation="flow"``, the orientation term and
+        ``opposite_guide``.
+    source_segment, target_segment : ndarray of int, (T, Hs, Ws) and (H, W), optional
+        Labels; a target pixel matches only source centres of its label; target -1 is
+        not synthesized, source -1 is never matched. Default: one segment.
+    initial_nnf : NNF, optional
+        A full-resolution field (e.g. the previous frame's, shifted) downscaled to each
+        level and merged per pixel, by patch error, with the field from the coarser level.
+    """
+
+    source_colour: np.ndarray
+    source_guides: np.ndarray
+    target_guides: np.ndarray
+    colour_weights: np.ndarray
+    guide_weights: np.ndarray
+    weight_maps: np.ndarray | None = None
+    guide_weight_map: np.ndarray | None = None
+    opposite_guide: np.ndarray | None = None
+    source_angle: np.ndarray | None = None
+    target_angle: np.ndarray | None = None
+    source_segment: np.ndarray | None = None
+    target_segment: np.ndarray | None = None
+    initial_nnf: NNF | None = None
+
+
+@dataclass(frozen=True)
+class SynthesisResult:
+    """Output of :func:`synthesize`.
+
+    Attributes
+    ----------
+    image : ndarray, shape (H, W, Cc), float32
+    nnf : NNF
+    error : ndarray, shape (H, W), float32
+        Final patch cost per pixel (without the uniformity penalty); inf where unmatched.
+    """
+
+    image: np.ndarray
+    nnf: NNF
+    error: np.ndarray
+
+    def mean_error(self):
+        """Mean final patch cost over matched pixels."""
+        finite = self.error[np.isfinite(self.error)]
+        return float(finite.mean()) if finite.size else float("nan")
+
+
+def _check_inputs(inputs):
+    colour = inputs.source_colour
+    if colour.ndim != 4:
+        raise ValueError(f"source_colour must have shape (T, Hs, Ws, Cc), got {colour.shape}")
+    frames, source_height, source_width, colours = colour.shape
+    guides = inputs.source_guides
+    if guides.ndim != 4 or guides.shape[:3] != colour.shape[:3]:
+        raise ValueError(f"source_guides must have shape {colour.shape[:3] + ('G',)}, got {guides.shape}")
+    target = inputs.target_guides
+    if target.ndim != 3 or target.shape[2] != guides.shape[3]:
+        raise ValueError(f"target_guides must have shape (H, W, {guides.shape[3]}), got {target.shape}")
+    height, width = target.shape[:2]
+    if np.shape(inputs.colour_weights) != (colours,) or np.shape(inputs.guide_weights) != (guides.shape[3],):
+        raise ValueError("colour_weights and guide_weights need one weight per channel")
+    shapes = {
+        "weight_maps": (None, height, width), "source_angle": (frames, source_height, source_width),
+        "target_angle": (height, width), "source_segment": (frames, source_height, source_width),
+        "target_segment": (height, width),
+    }
+    for name, shape in shapes.items():
+        value = getattr(inputs, name)
+        if value is not None and (value.ndim != len(shape) or any(s is not None and s != v for s, v in zip(shape, value.shape))):
+            raise ValueError(f"{name} must have shape {shape}, got {value.shape}")
+    if inputs.initial_nnf is not None and inputs.initial_nnf.shape != (height, width):
+        raise ValueError(f"initial_nnf must have shape {(height, width)}, got {inputs.initial_nnf.shape}")
+
+
+def _schedule(values, index):
+    return values[min(index, len(values) - 1)]
+
+
+def _pyramid_or_none(array, levels, halve):
+    if array is None:
+        return [None] * levels
+    out = [np.ascontiguousarray(array)]
+    for _ in range(levels - 1):
+        out.append(halve(out[-1]))
+    return out
+
+
+def _downsample_maps(maps):
+    return np.ascontiguousarray(np.moveaxis(downsample(np.moveaxis(maps, 0, -1)), -1, 0))
+
+
+def synthesize(inputs, params=SynthesisParams()):
+    """Synthesize a target image from a source sequence with guided patch optimisation.
+
+    Parameters
+    ----------
+    inputs : SynthesisInputs
+    params : SynthesisParams
+
+    Returns
+    -------
+    SynthesisResult
+    """
+    _check_inputs(inputs)
+    frames, source_height, source_width, colours = inputs.source_colour.shape
+    height, width = inputs.target_guides.shape[:2]
+    fit = levels_that_fit([(source_height, source_width), (height, width)], patch_size=params.patch_size)
+    levels = fit if params.pyramid_levels is None else min(params.pyramid_levels, fit)
+    rotation_mode = _ROTATIONS[params.rotation]
+    if rotation_mode == ROTATION_FLOW and (inputs.source_angle is None or inputs.target_angle is None):
+        raise ValueError('rotation="flow" needs source_angle and target_angle')
+
+    source_segment = inputs.source_segment
+    if source_segment is None:
+        source_segment = np.zeros((frames, source_height, source_width), np.int32)
+    target_segment = inputs.target_segment
+    if target_segment is None:
+        target_segment = np.zeros((height, width), np.int32)
+    source_colour = gaussian_pyramid(inputs.source_colour, levels)
+    source_guides = gaussian_pyramid(inputs.source_guides, levels)
+    target_guides = gaussian_pyramid(inputs.target_guides, levels)
+    weight_maps = _pyramid_or_none(inputs.weight_maps, levels, _downsample_maps)
+    source_angle = _pyramid_or_none(inputs.source_angle, levels, downsample_angles)
+    target_angle = _pyramid_or_none(inputs.target_angle, levels, downsample_angles)
+    source_segments = _pyramid_or_none(np.asarray(source_segment, np.int32), levels, downsample_labels)
+    target_segments = _pyramid_or_none(np.asarray(target_segment, np.int32), levels, downsample_labels)
+
+    nnf = None
+    for rank, level in enumerate(range(levels - 1, -1, -1)):
+        level_height, level_width = target_guides[level].shape[:2]
+        level_source_shape = source_colour[level].shape[1:3]
+        cost = build_patch_cost(
+            source_colour=source_colour[level], source_guides=source_guides[level],
+            target_colour=np.zeros((level_height, level_width, colours), np.float32),
+            target_guides=target_guides[level], colour_weights=inputs.colour_weights,
+            guide_weights=inputs.guide_weights, guide_weight_map=inputs.guide_weight_map,
+            weight_maps=weight_maps[level], opposite_guide=inputs.opposite_guide,
+            source_angle=source_angle[level], target_angle=target_angle[level],
+            orientation_weight=params.orientation_weight, orientation_clamp=params.orientation_clamp,
+            source_segment=source_segments[level], target_segment=target_segments[level],
+            patch_size=params.patch_size,
+        )
+        index = segment_index(cost.source_segment)
+
+        def repair(field, salt):
+            fill_random(
+                field, target_segment=cost.target_segment, source_segment=cost.source_segment, seed=params.seed, salt=salt, replace_all=False,
+                rotation_mode=rotation_mode, target_angle=target_angle[level], source_angle=source_angle[level],
+                index=index,
+            )
+
+        def revote():
+            colour, _ = vote(source_colour[level], nnf, patch_size=params.patch_size)
+            cost.set_target_colour(colour)
+            return colour
+
+        def downscaled_initial():
+            field = downscale_nnf(inputs.initial_nnf, steps=level, target_shape=(level_height, level_width),
+                                  source_shape=level_source_shape)
+            repair(field, _salt(level, 1, 0, 0))
+            return field
+
+        random_start = nnf is None and inputs.initial_nnf is None
+        if nnf is None:
+            nnf = downscaled_initial() if inputs.initial_nnf is not None else NNF.empty(level_height, level_width)
+            repair(nnf, _salt(level, 0, 0, 0))
+        else:
+            nnf = upscale_nnf(nnf, target_shape=(level_height, level_width), source_shape=level_source_shape)
+            repair(nnf, _salt(level, 0, 0, 0))
+            if inputs.initial_nnf is not None:
+                revote()
+                other = downscaled_initial()
+                nnf, _ = merge_nnf(nnf, other, patch_errors(cost, nnf), patch_errors(cost, other))
+        colour = revote()
+
+        if random_start and params.guided_initialization:
+            guides_cost = cost.guides_only()
+            error = patch_errors(guides_cost, nnf)
+            for iteration in range(_schedule(params.patchmatch_iters, rank)):
+                patchmatch_pass(guides_cost, nnf, error, rotation_mode=rotation_mode, alpha=params.alpha,
+                                seed=params.seed, salt=_salt(level, 2, 0, iteration), reverse=iteration % 2 == 1,
+                                tile_rows=params.tile_rows)
+            colour = revote()
+
+        if level == 0 and levels > 1 and params.vote_only_finest:
+            break
+        scales = None
+        if params.uniformity_weight > 0:
+            scales = budget_scales(source_segment=cost.source_segment, target_segment=cost.target_segment,
+                                   patch_size=params.patch_size, frame_radius=params.uniformity_radius,
+                                   weight=params.uniformity_weight)
+        for em in range(_schedule(params.search_vote_iters, rank)):
+            error = patch_errors(cost, nnf)
+            for iteration in range(_schedule(params.patchmatch_iters, rank)):
+                penalty = None
+                if scales is not None:
+                    occurrence = occurrence_map(nnf, source_shape=cost.source_segment.shape,
+                                                patch_size=params.patch_size, frame_radius=params.uniformity_radius)
+                    penalty = uniformity_penalty(occurrence, source_segment=cost.source_segment, scales=scales,
+                                                 patch_size=params.patch_size)
+                patchmatch_pass(cost, nnf, error, penalty=penalty, rotation_mode=rotation_mode, alpha=params.alpha,
+                                seed=params.seed, salt=_salt(level, 3, em, iteration), reverse=iteration % 2 == 1,
+                                tile_rows=params.tile_rows)
+            colour = revote()
+    return SynthesisResult(image=colour, nnf=nnf, error=patch_errors(cost, nnf))
+
+
+def _salt(level, phase, em, iteration):
+    """A distinct random-stream number per (level, phase, search-vote and PatchMatch iteration)."""
+    return ((level * 8 + phase) * 4096 + em) * 4096 + iteration
