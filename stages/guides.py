@@ -1,0 +1,377 @@
+"""The ``guides`` stage: guidance channels of a mask sequence, streamed frame by frame.
+
+For every frame ``j`` of a mask sequence it produces (ALGORITHM.md, "Guidance
+channels"): the smoothed mask, the signed distance ``dist``, the ``shape`` channel,
+the border/interior ``segments``, the ``flow`` (estimated from the masks or given), its
+orientation and the motion extents ``ext+`` and ``ext−``.
+
+Frame conventions: ``flow[j]`` is the motion that brought the material to frame ``j``
+(from ``j − 1``; for the first frame, the motion to the second). The accumulators are
+``acc+[j] = mask[j] · (acc+[j−1] + flow[j])`` from ``acc+[0] = 0`` and
+``acc−[j] = mask[j] · (acc−[j+1] + flow[j+1])`` from ``acc−[T−1] = 0``, so reversing a
+sequence negates its flows and swaps ext+ and ext−. An estimated flow is defined
+everywhere: outside the mask it is the smooth extension of the boundary motion (so
+ext− sees the motion of a boundary that recedes past a pixel).
+
+Memory does not grow with the number of frames: the forward quantities are computed in
+one pass with a fixed window of frames in memory and written to an on-disk cache of
+memory-mapped files (one mapping per frame access, released at once); ext− is then
+computed by a backward pass over that cache.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from dataclasses import asdict, dataclass
+from pathlib import Path
+from typing import Any, Callable, NamedTuple, Sequence, Union
+
+import numpy as np
+
+from fluidymation.engine import distance, extent, flow as flow_kernels
+from fluidymation.errors import StageError
+from fluidymation.stages.flow_io import read_flow
+
+NAME = "guides"
+VERSION = 1
+
+#: One mask per frame index: a callable ``masks(j)`` or a sequence ``masks[j]``.
+MaskSource = Union[Callable[[int], np.ndarray], Sequence[np.ndarray]]
+#: One flow per frame index, as an (H, W, 2) array or the path of a .npy/.flo file.
+FlowSource = Union[Callable[[int], Any], Sequence[Any]]
+#: ``progress(done, total)``, called after each unit of work.
+Progress = Callable[[int, int], None]
+
+
+@dataclass(frozen=True)
+class Params:
+    """Parameters of the guides stage; lengths in px at full resolution.
+
+    Attributes
+    ----------
+    blur_sigma : Gaussian blur of the masks before thresholding (thesis 4.1), px.
+    threshold : blurred coverage at or above which a pixel is inside; below 0.5 so the
+        mask includes a little paper.
+    dist_time_sigma : Gaussian smoothing of the distance fields along time before the
+        flow estimate, frames.
+    flow_time_radius : radius of the Gaussian smoothing of the estimated flow along
+        time, frames (the kernel spans 3 standard deviations).
+    shape_radius : radius ``b`` of the blur that makes the ``shape`` channel, px.
+    border_width : signed distance below which an inside pixel is in the border
+        segment, px.
+    scale : multiplies every px length above (e.g. the exemplar's scale factor).
+    relax_sweeps : relaxation sweeps per multigrid level of the interior flow fill.
+    """
+
+    blur_sigma: float = 8.0
+    threshold: float = 0.4
+    dist_time_sigma: float = 2.0
+    flow_time_radius: int = 3
+    shape_radius: float = 30.0
+    border_width: float = 10.0
+    scale: float = 1.0
+    relax_sweeps: int = 8
+
+    def __post_init__(self):
+        checks = (
+            ("blur_sigma", self.blur_sigma >= 0, "at least 0"),
+            ("threshold", 0 < self.threshold < 1, "between 0 and 1 (exclusive)"),
+            ("dist_time_sigma", self.dist_time_sigma >= 0, "at least 0"),
+            ("flow_time_radius", int(self.flow_time_radius) == self.flow_time_radius and self.flow_time_radius >= 0,
+             "a whole number of frames, at least 0"),
+            ("shape_radius", self.shape_radius >= 0, "at least 0"),
+            ("border_width", self.border_width > 0, "positive"),
+            ("scale", self.scale > 0, "positive"),
+            ("relax_sweeps", int(self.relax_sweeps) == self.relax_sweeps and self.relax_sweeps >= 1,
+             "a whole number, at least 1"),
+        )
+        for name, valid, wanted in checks:
+            if not valid:
+                raise StageError(f"guides: parameter {name} must be {wanted}, got {getattr(self, name)!r}")
+
+
+class FrameGuides(NamedTuple):
+    """The guidance channels of one frame; ``(H, W)`` unless noted."""
+
+    mask: np.ndarray  #: bool, the smoothed mask
+    dist: np.ndarray  #: float32 signed distance, positive inside
+    shape: np.ndarray  #: float32 in [0, 1]
+    segments: np.ndarray  #: uint8, distance.OUTSIDE / BORDER / INTERIOR
+    flow: np.ndarray  #: (H, W, 2) float32 (dx, dy) px/frame
+    direction: np.ndarray  #: float32 radians, atan2(dy, dx)
+    ext_plus: np.ndarray  #: float32
+    ext_minus: np.ndarray  #: float32
+
+
+class GuideCache:
+    """Per-frame guides on disk: one raw float32 file per channel, frames back to back.
+
+    Every access maps only the one frame it touches and releases the mapping, so the
+    resident memory does not grow with the number of frames.
+    """
+
+    CHANNELS = {"dist": 1, "shape": 1, "flow": 2, "ext_plus": 1, "ext_minus": 1}
+    _META = "guides.json"
+
+    def __init__(self, directory: str | os.PathLike, meta: dict):
+        self.directory = Path(directory)
+        self.meta = meta
+        self.frame_count = int(meta["frame_count"])
+        self.height = int(meta["height"])
+        self.width = int(meta["width"])
+        self.border_width = float(meta["border_width"])
+
+    @classmethod
+    def create(cls, directory, *, frame_count: int, height: int, width: int, border_width: float) -> GuideCache:
+        """Make an empty cache in ``directory`` (created if missing)."""
+        directory = Path(directory)
+        directory.mkdir(parents=True, exist_ok=True)
+        meta = {"frame_count": frame_count, "height": height, "width": width, "border_width": border_width}
+        cache = cls(directory, meta)
+        for channel, depth in cls.CHANNELS.items():
+            with open(cache._path(channel), "wb") as handle:
+                handle.truncate(frame_count * height * width * depth * 4)
+        cache.save_meta()
+        return cache
+
+    @classmethod
+    def open(cls, directory: str | os.PathLike) -> GuideCache:
+        """Open a cache written by :func:`compute_guides`."""
+        directory = Path(directory)
+        try:
+            meta = json.loads((directory / cls._META).read_text())
+        except (OSError, ValueError) as exc:
+            raise StageError(f"{directory}: not a guides cache ({exc})") from None
+        return cls(directory, meta)
+
+    def save_meta(self) -> None:
+        (self.directory / self._META).write_text(json.dumps(self.meta, indent=1))
+
+    def _path(self, channel: str) -> Path:
+        return self.directory / f"{channel}.f32"
+
+    def _map(self, channel: str, index: int, mode: str) -> np.memmap:
+        if not 0 <= index < self.frame_count:
+            raise IndexError(f"frame {index} outside 0..{self.frame_count - 1}")
+        depth = self.CHANNELS[channel]
+        shape = (self.height, self.width, depth) if depth > 1 else (self.height, self.width)
+        frame_bytes = self.height * self.width * depth * 4
+        return np.memmap(self._path(channel), dtype=np.float32, mode=mode, offset=index * frame_bytes, shape=shape)
+
+    def write(self, channel: str, index: int, array: np.ndarray) -> None:
+        view = self._map(channel, index, "r+")
+        view[...] = array
+        view.flush()
+        del view
+
+    def read(self, channel: str, index: int) -> np.ndarray:
+        view = self._map(channel, index, "r")
+        array = np.array(view)
+        del view
+        return array
+
+    def frame(self, index: int) -> FrameGuides:
+        """All channels of frame ``index``."""
+        dist = self.read("dist", index)
+        flow = self.read("flow", index)
+        return FrameGuides(
+            mask=dist > 0,
+            dist=dist,
+            shape=self.read("shape", index),
+            segments=distance.segments(dist, border_width=self.border_width),
+            flow=flow,
+            direction=extent.orientation(flow),
+            ext_plus=self.read("ext_plus", index),
+            ext_minus=self.read("ext_minus", index),
+        )
+
+
+class _Window:
+    """A per-frame quantity produced in increasing frame order and kept in a ring of
+    ``depth`` frames; indices outside the sequence are clamped to its ends."""
+
+    def __init__(self, frame_count: int, depth: int, produce: Callable[[int], np.ndarray]):
+        self.frame_count = frame_count
+        self.depth = depth
+        self.produce = produce
+        self.ring: np.ndarray | None = None
+        self.produced = 0
+
+    def _clamp(self, index: int) -> int:
+        return min(max(index, 0), self.frame_count - 1)
+
+    def get(self, index: int) -> np.ndarray:
+        """Frame ``index`` (clamped); valid until ``depth`` newer frames are produced."""
+        index = self._clamp(index)
+        while self.produced <= index:
+            value = self.produce(self.produced)
+            if self.ring is None:
+                self.ring = np.empty((self.depth,) + value.shape, dtype=np.float32)
+            self.ring[self.produced % self.depth] = value
+            self.produced += 1
+        if index < self.produced - self.depth:
+            raise RuntimeError(f"frame {index} already left the window (depth {self.depth})")
+        return self.ring[index % self.depth]
+
+    def smoothed(self, center: int, taps: np.ndarray) -> np.ndarray:
+        """``sum_k taps[k] · frame[center + k − r]`` with clamped frame indices."""
+        radius = taps.shape[0] // 2
+        self.get(center + radius)
+        slot_weights = np.zeros(self.depth, dtype=np.float32)
+        for offset in range(-radius, radius + 1):
+            index = self._clamp(center + offset)
+            self.get(index)
+            slot_weights[index % self.depth] += taps[offset + radius]
+        return flow_kernels.weighted_sum(self.ring, slot_weights)
+
+
+def _item_getter(source, what: str) -> Callable[[int], Any]:
+    if callable(source):
+        return source
+    if hasattr(source, "__getitem__"):
+        return source.__getitem__
+    raise TypeError(f"{what} must be a callable taking a frame index or a sequence, got {type(source).__name__}")
+
+
+def _coverage(mask: Any, index: int, shape: tuple[int, int] | None) -> np.ndarray:
+    """A mask as float32 coverage in [0, 1]: bool as is, uint8 divided by 255, floats as is."""
+    mask = np.asarray(mask)
+    if mask.ndim != 2:
+        raise StageError(f"guides: mask of frame {index} must be (H, W), got shape {mask.shape}")
+    if shape is not None and mask.shape != shape:
+        raise StageError(f"guides: mask of frame {index} has shape {mask.shape}, frame 0 has {shape}")
+    if mask.dtype == np.bool_:
+        return mask.astype(np.float32)
+    if mask.dtype == np.uint8:
+        return mask.astype(np.float32) / np.float32(255.0)
+    if np.issubdtype(mask.dtype, np.floating):
+        return np.clip(mask, 0.0, 1.0).astype(np.float32)
+    raise StageError(f"guides: mask of frame {index} has dtype {mask.dtype}; use bool, uint8 or float coverage")
+
+
+def _given_flow(item: Any, index: int, shape: tuple[int, int]) -> np.ndarray:
+    if isinstance(item, (str, os.PathLike)):
+        return read_flow(item, shape=shape)
+    flow = np.asarray(item)
+    if flow.shape != shape + (2,):
+        raise StageError(f"guides: given flow of frame {index} has shape {flow.shape}, expected {shape + (2,)}")
+    return np.array(flow, dtype=np.float32, order="C", copy=True)
+
+
+def compute_guides(
+    masks: MaskSource,
+    frame_count: int,
+    *,
+    params: Params,
+    cache_dir: str | os.PathLike,
+    given_flow: FlowSource | None = None,
+    progress: Progress | None = None,
+) -> GuideCache:
+    """Compute the guides of a whole mask sequence into an on-disk cache.
+
+    Parameters
+    ----------
+    masks : callable or sequence
+        ``masks(j)`` / ``masks[j]`` gives frame ``j``'s (H, W) mask: bool, uint8
+        (0..255) or float coverage in [0, 1]. Each frame is requested once, in order.
+    frame_count : int
+        Number of frames ``T``.
+    params : Params
+    cache_dir : path
+        Directory for the memory-mapped cache (about 24 bytes per pixel and frame).
+    given_flow : callable or sequence, optional
+        Flow of frame ``j`` as an (H, W, 2) float32 array (dx, dy) px/frame or a
+        ``.npy``/``.flo`` path; used as is in place of the estimate from the masks.
+    progress : callable, optional
+        ``progress(done, total)`` after each frame of each pass; ``total = 2·T``.
+
+    Returns
+    -------
+    GuideCache
+        Read frames with ``cache.frame(j)``; ``cache.meta`` also holds the largest
+        ``|flow|``, ext+, ext− and ``|dist|`` of the sequence.
+    """
+    if frame_count < 1:
+        raise StageError(f"guides: need at least one frame, got frame_count={frame_count}")
+    get_mask = _item_getter(masks, "masks")
+    get_flow = None if given_flow is None else _item_getter(given_flow, "given_flow")
+    scale = params.scale
+    border_width = params.border_width * scale
+    dist_taps = distance.gaussian_weights(params.dist_time_sigma)
+    flow_taps = distance.gaussian_weights(params.flow_time_radius / 3.0)
+    dist_radius = dist_taps.shape[0] // 2
+    flow_radius = flow_taps.shape[0] // 2
+
+    first = _coverage(get_mask(0), 0, None)
+    shape = first.shape
+    pending = {0: first}
+
+    def produce_dist(index: int) -> np.ndarray:
+        coverage = pending.pop(index) if index in pending else _coverage(get_mask(index), index, shape)
+        blurred = distance.gaussian_blur(coverage, sigma=params.blur_sigma * scale)
+        return distance.signed_distance(blurred, threshold=params.threshold)
+
+    dists = _Window(frame_count, 2 * dist_radius + flow_radius + 3, produce_dist)
+    smoothed_dists = _Window(frame_count, 3, lambda index: dists.smoothed(index, dist_taps))
+
+    def produce_raw_flow(index: int) -> np.ndarray:
+        mask = dists.get(index) > 0
+        if index == 0:
+            # motion to the next frame, seen on this frame's boundary
+            return -flow_kernels.flow_from_distances(
+                smoothed_dists.get(1), smoothed_dists.get(0), mask, sweeps=params.relax_sweeps
+            )
+        return flow_kernels.flow_from_distances(
+            smoothed_dists.get(index - 1), smoothed_dists.get(index), mask, sweeps=params.relax_sweeps
+        )
+
+    raw_flows = _Window(frame_count, 2 * flow_radius + 1, produce_raw_flow)
+
+    cache = GuideCache.create(
+        cache_dir, frame_count=frame_count, height=shape[0], width=shape[1], border_width=border_width
+    )
+    total = 2 * frame_count
+    accumulator = np.zeros(shape + (2,), dtype=np.float32)
+    zero_flow = np.zeros(shape + (2,), dtype=np.float32)
+    flow_max = ext_plus_max = dist_max = 0.0
+    for index in range(frame_count):
+        if get_flow is None:
+            frame_flow = raw_flows.smoothed(index, flow_taps)
+        else:
+            frame_flow = _given_flow(get_flow(index), index, shape)
+        frame_dist = dists.get(index).copy()
+        mask = frame_dist > 0
+        ext_plus = extent.accumulate_extent(accumulator, frame_flow if index > 0 else zero_flow, mask)
+        cache.write("dist", index, frame_dist)
+        cache.write("shape", index, distance.shape_channel(mask, radius=params.shape_radius * scale))
+        cache.write("flow", index, frame_flow)
+        cache.write("ext_plus", index, ext_plus)
+        flow_max = max(flow_max, float(np.sqrt((frame_flow**2).sum(axis=2).max())))
+        ext_plus_max = max(ext_plus_max, float(ext_plus.max()))
+        dist_max = max(dist_max, float(np.abs(frame_dist).max()))
+        if progress is not None:
+            progress(index + 1, total)
+
+    accumulator[...] = 0.0
+    ext_minus_max = 0.0
+    for index in range(frame_count - 1, -1, -1):
+        mask = cache.read("dist", index) > 0
+        step = cache.read("flow", index + 1) if index + 1 < frame_count else zero_flow
+        ext_minus = extent.accumulate_extent(accumulator, step, mask)
+        cache.write("ext_minus", index, ext_minus)
+        ext_minus_max = max(ext_minus_max, float(ext_minus.max()))
+        if progress is not None:
+            progress(2 * frame_count - index, total)
+
+    cache.meta.update(
+        flow_max=flow_max,
+        ext_plus_max=ext_plus_max,
+        ext_minus_max=ext_minus_max,
+        dist_max=dist_max,
+        params=asdict(params),
+        flow_given=given_flow is not None,
+    )
+    cache.save_meta()
+    return cache
+
