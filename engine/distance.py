@@ -19,6 +19,11 @@ from fluidymation.engine._jit import parallel_kernel
 
 #: Smallest |distance| given to a pixel, so that inside is exactly ``dist > 0``.
 _MIN_DISTANCE = 1e-4
+#: Largest sideways offset (px) of a boundary foot for which a pixel measures its
+#: distance to the tangent there rather than to the foot point.
+_TANGENT_REACH = 1.5
+#: Half-size of the window around the nearest boundary pixel searched for the foot.
+_FOOT_SEARCH = 2
 
 OUTSIDE = 0
 BORDER = 1
@@ -86,7 +91,7 @@ def gaussian_blur(image: np.ndarray, *, sigma: float) -> np.ndarray:
 
 
 @parallel_kernel
-def _boundary_feet(coverage, threshold, mask, seed, foot_y, foot_x):
+def _boundary_feet(coverage, threshold, mask, seed, foot_y, foot_x, normal_y, normal_x):
     """Mark pixels with a 4-neighbour on the other side of the mask as seeds and put
     on each the foot of the perpendicular to the level set ``coverage = threshold``."""
     height, width = mask.shape
@@ -102,8 +107,8 @@ def _boundary_feet(coverage, threshold, mask, seed, foot_y, foot_x):
             grad_y = (coverage[y1, x] - coverage[y0, x]) / max(y1 - y0, 1)
             norm = math.sqrt(grad_x * grad_x + grad_y * grad_y)
             best = 2.0
-            best_dx = 0.0
-            best_dy = 0.0
+            best_nx = 0.0
+            best_ny = 0.0
             for k in range(4):
                 dx = 1 if k == 0 else -1 if k == 1 else 0
                 dy = 1 if k == 2 else -1 if k == 3 else 0
@@ -115,39 +120,58 @@ def _boundary_feet(coverage, threshold, mask, seed, foot_y, foot_x):
                 # fraction of the step, then projected on the level set's normal
                 step = value / (coverage[y, x] - coverage[ny, nx]) if coverage[y, x] != coverage[ny, nx] else 0.5
                 step = min(max(step, 0.0), 1.0)
+                towards_x = float(dx)
+                towards_y = float(dy)
+                along = 1.0
                 if norm > 0.0:
-                    normal_x = -grad_x / norm if inside else grad_x / norm
-                    normal_y = -grad_y / norm if inside else grad_y / norm
-                    along = normal_x * dx + normal_y * dy
-                    if along <= 0.0:
-                        normal_x = float(dx)
-                        normal_y = float(dy)
-                        along = 1.0
-                else:
-                    normal_x = float(dx)
-                    normal_y = float(dy)
-                    along = 1.0
+                    gx = -grad_x / norm if inside else grad_x / norm
+                    gy = -grad_y / norm if inside else grad_y / norm
+                    if gx * dx + gy * dy > 0.0:
+                        towards_x = gx
+                        towards_y = gy
+                        along = gx * dx + gy * dy
                 reach = step * along
                 if reach < best:
                     best = reach
-                    best_dx = reach * normal_x
-                    best_dy = reach * normal_y
+                    best_nx = towards_x
+                    best_ny = towards_y
             seed[y, x] = best < 2.0
-            foot_x[y, x] = x + best_dx
-            foot_y[y, x] = y + best_dy
+            foot_x[y, x] = x + best * best_nx
+            foot_y[y, x] = y + best * best_ny
+            normal_x[y, x] = best_nx
+            normal_y[y, x] = best_ny
 
 
 @parallel_kernel
-def _distance_to_feet(nearest, foot_y, foot_x, mask, out):
+def _distance_to_feet(nearest, seed, foot_y, foot_x, normal_y, normal_x, mask, out):
     height, width = mask.shape
     for y in prange(height):
         for x in range(width):
-            sy = nearest[0, y, x]
-            sx = nearest[1, y, x]
-            length = math.sqrt((y - foot_y[sy, sx]) ** 2 + (x - foot_x[sy, sx]) ** 2)
+            # the nearest boundary pixel by pixel centres need not have the nearest
+            # foot: take the best foot among the boundary pixels around it
+            near_y = nearest[0, y, x]
+            near_x = nearest[1, y, x]
+            best_squared = np.inf
+            sy = near_y
+            sx = near_x
+            for cy in range(max(near_y - _FOOT_SEARCH, 0), min(near_y + _FOOT_SEARCH + 1, height)):
+                for cx in range(max(near_x - _FOOT_SEARCH, 0), min(near_x + _FOOT_SEARCH + 1, width)):
+                    if not seed[cy, cx]:
+                        continue
+                    squared = (y - foot_y[cy, cx]) ** 2 + (x - foot_x[cy, cx]) ** 2
+                    if squared < best_squared:
+                        best_squared = squared
+                        sy = cy
+                        sx = cx
+            dy = y - foot_y[sy, sx]
+            dx = x - foot_x[sy, sx]
+            # distance to the boundary's tangent at the foot, unless the foot lies far
+            # to the side (corners), where the distance to the foot itself is better
+            across = abs(dx * normal_x[sy, sx] + dy * normal_y[sy, sx])
+            sideways = abs(dx * normal_y[sy, sx] - dy * normal_x[sy, sx])
+            length = across if sideways <= _TANGENT_REACH else math.sqrt(best_squared)
             length = max(length, _MIN_DISTANCE)
             out[y, x] = length if mask[y, x] else -length
-
 
 
 def signed_distance(coverage: np.ndarray, *, threshold: float = 0.5) -> np.ndarray:
@@ -156,7 +180,8 @@ def signed_distance(coverage: np.ndarray, *, threshold: float = 0.5) -> np.ndarr
     The boundary is located with sub-pixel precision: on every pixel next to the other
     side, the crossing of the threshold is interpolated linearly along the pixel axes
     and projected on the coverage gradient; every pixel then measures its distance to
-    the foot point of its nearest such boundary pixel (scipy's exact EDT). For a binary
+    the boundary's tangent at the foot point of its nearest such boundary pixel
+    (found by scipy's exact EDT). For a binary
     mask the crossing lies on the pixel edge, so neighbours across a straight boundary
     get +0.5 and -0.5.
 
@@ -180,12 +205,11 @@ def signed_distance(coverage: np.ndarray, *, threshold: float = 0.5) -> np.ndarr
         diagonal = math.hypot(*mask.shape)
         return np.full(mask.shape, diagonal if mask.all() else -diagonal, dtype=np.float32)
     seed = np.empty(mask.shape, dtype=np.bool_)
-    foot_y = np.empty(mask.shape, dtype=np.float32)
-    foot_x = np.empty(mask.shape, dtype=np.float32)
-    _boundary_feet(coverage, np.float32(threshold), mask, seed, foot_y, foot_x)
+    foot_y, foot_x, normal_y, normal_x = np.empty((4,) + mask.shape, dtype=np.float32)
+    _boundary_feet(coverage, np.float32(threshold), mask, seed, foot_y, foot_x, normal_y, normal_x)
     nearest = ndimage.distance_transform_edt(~seed, return_distances=False, return_indices=True)
     out = np.empty(mask.shape, dtype=np.float32)
-    _distance_to_feet(np.ascontiguousarray(nearest, dtype=np.int32), foot_y, foot_x, mask, out)
+    _distance_to_feet(np.ascontiguousarray(nearest, dtype=np.int32), seed, foot_y, foot_x, normal_y, normal_x, mask, out)
     return out
 
 

@@ -1,24 +1,7 @@
 """Slow, obvious reference versions of engine kernels, for tests on tiny inputs."""
 
 
-# --- guides (issue 4): signed distance, boundary flow, Laplace fill, extent -----------
-
-
-def naive_signed_distance(mask):
-    """Brute force: distance to the nearest pixel centre of the other side, minus 0.5."""
-    import numpy as np
-
-    mask = np.asarray(mask, dtype=bool)
-    ys, xs = np.nonzero(mask)
-    oys, oxs = np.nonzero(~mask)
-    out = np.empty(mask.shape, dtype=np.float64)
-    for y in range(mask.shape[0]):
-        for x in range(mask.shape[1]):
-            if mask[y, x]:
-                out[y, x] = np.sqrt(((oys - y) ** 2 + (oxs - x) ** 2).min()) - 0.5
-            else:
-                out[y, x] = 0.5 - np.sqrt(((ys - y) ** 2 + (xs - x) ** 2).min())
-    return out
+# --- guides (issue 4): Laplace fill, extent accumulation -----------
 
 
 def naive_harmonic_fill(values, fixed, domain):
@@ -75,3 +58,62 @@ def naive_extent(flows, masks):
         acc = np.where(masks[j][..., None], acc + (flows[j + 1] if j < count - 1 else 0.0), 0.0)
         backward[j] = np.hypot(acc[..., 0], acc[..., 1])
     return np.array(forward), np.array(backward)
+
+
+def naive_advect_pigment(u, v, pigment, substeps):
+    """Upwind advection of a cell-centred field by face velocities u (H, W+1), v (H+1, W):
+    each substep moves dt·u·(upwind cell value) across every interior face."""
+    import numpy as np
+
+    pigment = np.array(pigment, dtype=np.float64)
+    height, width = pigment.shape
+    dt = 1.0 / substeps
+    for _ in range(substeps):
+        new = pigment.copy()
+        for y in range(height):
+            for x in range(1, width):
+                donor = pigment[y, x - 1] if u[y, x] > 0 else pigment[y, x]
+                moved = dt * u[y, x] * donor
+                new[y, x - 1] -= moved
+                new[y, x] += moved
+        for y in range(1, height):
+            for x in range(width):
+                donor = pigment[y - 1, x] if v[y, x] > 0 else pigment[y, x]
+                moved = dt * v[y, x] * donor
+                new[y - 1, x] -= moved
+                new[y, x] += moved
+        pigment = new
+    return pigment
+
+
+def naive_arrival_times(inside, cost):
+    """Shortest 8-neighbour path time from the boundary (Bellman–Ford relaxation)."""
+    import numpy as np
+
+    height, width = inside.shape
+    times = np.full((height, width), np.inf)
+    for y in range(height):
+        for x in range(width):
+            if not inside[y, x]:
+                continue
+            neighbours = [(y + dy, x + dx) for dy in (-1, 0, 1) for dx in (-1, 0, 1)]
+            if any(not (0 <= ny < height and 0 <= nx < width) or not inside[ny, nx] for ny, nx in neighbours):
+                times[y, x] = 0.5 * cost[y, x]
+    changed = True
+    while changed:
+        changed = False
+        for y in range(height):
+            for x in range(width):
+                if not inside[y, x]:
+                    continue
+                for dy in (-1, 0, 1):
+                    for dx in (-1, 0, 1):
+                        ny, nx = y + dy, x + dx
+                        if (dy, dx) == (0, 0) or not (0 <= ny < height and 0 <= nx < width) or not inside[ny, nx]:
+                            continue
+                        step = np.sqrt(2.0) if dy and dx else 1.0
+                        candidate = times[ny, nx] + 0.5 * (cost[y, x] + cost[ny, nx]) * step
+                        if candidate < times[y, x] - 1e-12:
+                            times[y, x] = candidate
+                            changed = True
+    return times

@@ -1,0 +1,80 @@
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from fluidymation.engine import flow
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+import naive  # noqa: E402
+
+SIZE = 72
+YY, XX = np.mgrid[:SIZE, :SIZE].astype(np.float64)
+
+
+def _disk_distance(cx, cy, radius):
+    return (radius - np.hypot(XX - cx, YY - cy)).astype(np.float32)
+
+
+def _inner_boundary(mask):
+    padded = np.pad(mask, 1, mode="edge")
+    all_inside = padded[:-2, 1:-1] & padded[2:, 1:-1] & padded[1:-1, :-2] & padded[1:-1, 2:]
+    return mask & ~all_inside
+
+
+def test_translating_disk_boundary_flow_points_along_the_motion():
+    velocity = np.array([1.5, -0.75])
+    centre = np.array([35.3, 36.1])
+    before = _disk_distance(*(centre - velocity), 20.0)
+    after = _disk_distance(*centre, 20.0)
+    result = flow.flow_from_distances(before, after, after > 0)
+    ys, xs = np.nonzero(_inner_boundary(after > 0))
+    normals = np.stack([xs - centre[0], ys - centre[1]], axis=1)
+    normals /= np.linalg.norm(normals, axis=1, keepdims=True)
+    along = normals @ (velocity / np.linalg.norm(velocity))
+    lead_trail = np.abs(along) >= 0.98
+    assert lead_trail.sum() >= 6
+    vectors = result[ys, xs][lead_trail]
+    cosine = vectors @ velocity / np.linalg.norm(vectors, axis=1) / np.linalg.norm(velocity)
+    assert cosine.min() >= 0.95
+    speed = np.linalg.norm(vectors, axis=1)
+    np.testing.assert_allclose(speed, np.abs(normals[lead_trail] @ velocity), rtol=0.05)
+
+
+def test_growing_disk_flow_points_outward_and_interior_is_harmonic():
+    growth = 1.25
+    result = flow.flow_from_distances(_disk_distance(36, 36, 24.0 - growth), _disk_distance(36, 36, 24.0), _disk_distance(36, 36, 24.0) > 0)
+    radius = np.hypot(XX - 36, YY - 36)
+    outward = np.stack([XX - 36, YY - 36], axis=2) / np.maximum(radius, 1e-9)[:, :, None]
+    boundary = _inner_boundary(radius < 24.0)
+    speed = np.linalg.norm(result, axis=2)
+    np.testing.assert_allclose(speed[boundary], growth, rtol=0.02)
+    assert ((result * outward).sum(axis=2)[boundary] > 0.99 * speed[boundary]).all()
+    # the harmonic extension of g·n over a disk of radius R is g·r/R·n
+    inside = radius < 22.0
+    expected = growth * radius / 24.0
+    assert np.abs(speed - expected)[inside].max() < 0.05 * growth
+
+
+def test_static_mask_has_zero_flow():
+    dist = _disk_distance(30, 40, 15.0)
+    assert not flow.flow_from_distances(dist, dist, dist > 0).any()
+
+
+def test_harmonic_fill_matches_a_sparse_direct_solve():
+    domain = (np.hypot(XX[:40, :40] - 18, YY[:40, :40] - 20) < 16) | (np.abs(XX[:40, :40] - 30) + np.abs(YY[:40, :40] - 10) < 8)
+    fixed = _inner_boundary(domain)
+    fixed[20, 18] = True  # an interior Dirichlet point too
+    values = np.stack([np.cos(XX[:40, :40] / 6.0) + YY[:40, :40] / 20.0, np.sin(YY[:40, :40] / 5.0)], axis=2).astype(np.float32)
+    expected = naive.naive_harmonic_fill(values.astype(np.float64), fixed, domain)
+    result = flow.harmonic_fill(values, fixed, domain, sweeps=8)
+    spread = np.ptp(values[fixed])
+    assert np.abs(result - expected).max() < 0.02 * spread
+    assert not result[~domain].any()
+
+
+def test_weighted_sum_matches_numpy():
+    rng = np.random.default_rng(3)
+    stack = rng.random((5, 7, 9, 2)).astype(np.float32)
+    weights = np.array([0.1, 0.0, 0.5, 0.25, 0.15], dtype=np.float32)
+    np.testing.assert_allclose(flow.weighted_sum(stack, weights), np.tensordot(weights, stack, axes=1), rtol=1e-5)
