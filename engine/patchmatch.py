@@ -41,13 +41,31 @@ _INF = np.float32(np.inf)
 
 
 @kernel
+def _window_ssd(source_rows, target_rows, source_row, source_column, target_row, target_column, size, length, bound):
+    """SSD of two n×n windows of all features, rows read as contiguous runs of n·F values."""
+    total = np.float32(0.0)
+    for dy in range(size):
+        source_run = source_rows[source_row + dy, source_column:source_column + length]
+        target_run = target_rows[target_row + dy, target_column:target_column + length]
+        row_total = np.float32(0.0)
+        for k in range(length):
+            d = source_run[k] - target_run[k]
+            row_total += d * d
+        total += row_total
+        if total > bound:
+            return total
+    return total
+
+
+@kernel
 def _patch_cost(
-    source, target, feature_start, plain_end, group_ends, weight_maps, opposite_feature,
+    source, target, source_rows, target_rows, feature_start, plain_end, group_ends, weight_maps, opposite_feature,
     source_angle, target_angle, orientation_weight, orientation_clamp, use_opposite,
     radius, tx, ty, frame, x, y, theta, bound,
 ):
     height = target.shape[0]
     width = target.shape[1]
+    features = target.shape[2]
     source_height = source.shape[1]
     source_width = source.shape[2]
     groups = group_ends.shape[0]
@@ -62,6 +80,14 @@ def _patch_cost(
         theta == 0.0 and x == sx and y == sy and not opposite and orientation_weight == 0.0
         and radius <= sx < source_width - radius and radius <= sy < source_height - radius
     ):
+        if (
+            groups == 0 and feature_start == 0
+            and radius <= tx < width - radius and radius <= ty < height - radius
+        ):
+            return _window_ssd(
+                source_rows, target_rows, frame * source_height + sy - radius, (sx - radius) * features,
+                ty - radius, (tx - radius) * features, 2 * radius + 1, (2 * radius + 1) * features, bound,
+            )
         for dy in range(-radius, radius + 1):
             qy = ty + dy
             if qy < 0 or qy >= height:
@@ -127,7 +153,7 @@ def _patch_cost(
 
 @parallel_kernel
 def _evaluate(
-    source, target, feature_start, plain_end, group_ends, weight_maps, opposite_feature,
+    source, target, source_rows, target_rows, feature_start, plain_end, group_ends, weight_maps, opposite_feature,
     source_angle, target_angle, orientation_weight, orientation_clamp, use_opposite, radius,
     nnf_frame, nnf_coords, out,
 ):
@@ -139,9 +165,9 @@ def _evaluate(
                 out[ty, tx] = np.inf
                 continue
             out[ty, tx] = _patch_cost(
-                source, target, feature_start, plain_end, group_ends, weight_maps, opposite_feature,
-                source_angle, target_angle, orientation_weight, orientation_clamp, use_opposite, radius,
-                tx, ty, frame, nnf_coords[ty, tx, 0], nnf_coords[ty, tx, 1], nnf_coords[ty, tx, 2], np.inf,
+                source, target, source_rows, target_rows, feature_start, plain_end, group_ends, weight_maps,
+                opposite_feature, source_angle, target_angle, orientation_weight, orientation_clamp, use_opposite,
+                radius, tx, ty, frame, nnf_coords[ty, tx, 0], nnf_coords[ty, tx, 1], nnf_coords[ty, tx, 2], np.inf,
             )
 
 
@@ -154,7 +180,7 @@ def _penalty_at(penalty, use_penalty, frame, x, y):
 
 @parallel_kernel
 def _search(
-    source, target, feature_start, plain_end, group_ends, weight_maps, opposite_feature,
+    source, target, source_rows, target_rows, feature_start, plain_end, group_ends, weight_maps, opposite_feature,
     source_angle, target_angle, orientation_weight, orientation_clamp, use_opposite, radius,
     source_segment, target_segment, penalty, use_penalty,
     nnf_frame, nnf_coords, error, start_frame, start_coords,
@@ -221,8 +247,9 @@ def _search(
                     if cand_penalty >= best_total:
                         continue
                     cand_error = _patch_cost(
-                        source, target, feature_start, plain_end, group_ends, weight_maps, opposite_feature,
-                        source_angle, target_angle, orientation_weight, orientation_clamp, use_opposite, radius,
+                        source, target, source_rows, target_rows, feature_start, plain_end, group_ends,
+                        weight_maps, opposite_feature, source_angle, target_angle, orientation_weight,
+                        orientation_clamp, use_opposite, radius,
                         tx, ty, cand_frame, cx, cy, cand_theta, best_total - cand_penalty,
                     )
                     if cand_error + cand_penalty < best_total:
@@ -268,8 +295,9 @@ def _search(
                                 _flow_rotation(target_angle, source_angle, cand_frame, cx, cy, tx, ty, flip == 1)
                             )
                         cand_error = _patch_cost(
-                            source, target, feature_start, plain_end, group_ends, weight_maps, opposite_feature,
-                            source_angle, target_angle, orientation_weight, orientation_clamp, use_opposite, radius,
+                            source, target, source_rows, target_rows, feature_start, plain_end, group_ends,
+                            weight_maps, opposite_feature, source_angle, target_angle, orientation_weight,
+                            orientation_clamp, use_opposite, radius,
                             tx, ty, cand_frame, cx, cy, cand_theta, best_total - cand_penalty,
                         )
                         if cand_error + cand_penalty < best_total:
@@ -349,8 +377,12 @@ class PatchCost:
         np.multiply(colour, self.colour_scale, out=self.target_features[:, :, : self.colour_channels])
 
     def kernel_args(self):
+        frames, source_height, source_width, features = self.source_features.shape
+        height, width = self.target_features.shape[:2]
         return (
-            self.source_features, self.target_features, self.feature_start, self.plain_end, self.group_ends,
+            self.source_features, self.target_features,
+            self.source_features.reshape(frames * source_height, source_width * features),
+            self.target_features.reshape(height, width * features), self.feature_start, self.plain_end, self.group_ends,
             self.weight_maps, self.opposite_feature, self.source_angle, self.target_angle,
             np.float32(self.orientation_weight), np.float32(self.orientation_clamp), self.use_opposite,
             self.patch_size // 2,
@@ -379,7 +411,7 @@ def build_patch_cost(*, source_colour, source_guides, target_colour, target_guid
         Per-target-pixel weight multipliers.
     opposite_guide : array-like of int, shape (G,), optional
         Source guide channel compared with guide g when flows are opposite
-        (requires the angles).
+        (requires the angles; swapped guides must have equal weights).
     source_angle, target_angle : ndarray, (T, Hs, Ws) and (H, W), float32, optional
         Flow orientations in radians.
     orientation_weight, orientation_clamp : float
@@ -426,6 +458,8 @@ def build_patch_cost(*, source_colour, source_guides, target_colour, target_guid
     use_opposite = opposite_guide is not None
     if use_opposite:
         opposite_guide = np.asarray(opposite_guide, np.int64).reshape(guides)
+        if (guide_weights[opposite_guide] != guide_weights).any():
+            raise ValueError("guides swapped by opposite_guide must have equal weights")
         opposite_feature[colours + position] = colours + position[opposite_guide]
     needs_angles = use_opposite or orientation_weight > 0
     if needs_angles and (source_angle is None or target_angle is None):

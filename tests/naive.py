@@ -117,3 +117,123 @@ def naive_arrival_times(inside, cost):
                             times[y, x] = candidate
                             changed = True
     return times
+
+
+# --- patch synthesis engine (issue 3) ----------------------------------------
+
+
+def naive_bilinear(image, x, y):
+    """Bilinear sample of (H, W, C) ``image`` at (x, y), coordinates clamped to the image."""
+    import math
+
+    import numpy as np
+
+    height, width = image.shape[:2]
+    x = min(max(x, 0.0), width - 1.0)
+    y = min(max(y, 0.0), height - 1.0)
+    x0, y0 = int(math.floor(x)), int(math.floor(y))
+    x1, y1 = min(x0 + 1, width - 1), min(y0 + 1, height - 1)
+    fx, fy = x - x0, y - y0
+    top = (1 - fx) * image[y0, x0].astype(np.float64) + fx * image[y0, x1]
+    bottom = (1 - fx) * image[y1, x0].astype(np.float64) + fx * image[y1, x1]
+    return (1 - fy) * top + fy * bottom
+
+
+def naive_window_offsets(patch_size):
+    radius = patch_size // 2
+    return [(dx, dy) for dy in range(-radius, radius + 1) for dx in range(-radius, radius + 1)]
+
+
+def naive_rotate(theta, dx, dy):
+    """R(θ)(dx, dy) with R = [[cos, −sin], [sin, cos]]."""
+    import math
+
+    return math.cos(theta) * dx - math.sin(theta) * dy, math.sin(theta) * dx + math.cos(theta) * dy
+
+
+def naive_patch_cost(source, target, weights, frame, x, y, theta, tx, ty, patch_size):
+    """Σ over the window's in-target pixels of Σ_c w_c (S(p + R(θ)d) − T(q + d))², float64."""
+    import numpy as np
+
+    total = 0.0
+    for dx, dy in naive_window_offsets(patch_size):
+        qx, qy = tx + dx, ty + dy
+        if not (0 <= qx < target.shape[1] and 0 <= qy < target.shape[0]):
+            continue
+        ox, oy = naive_rotate(theta, dx, dy)
+        value = naive_bilinear(source[frame], x + ox, y + oy)
+        total += float(np.sum(np.asarray(weights) * (value - target[qy, qx]) ** 2))
+    return total
+
+
+def naive_vote(source, frames, coords, patch_size):
+    """Average of every covering patch's collocated (rotated, bilinear) source sample."""
+    import numpy as np
+
+    height, width = frames.shape
+    out = np.zeros((height, width, source.shape[3]))
+    for ty in range(height):
+        for tx in range(width):
+            samples = []
+            for dx, dy in naive_window_offsets(patch_size):
+                nx, ny = tx - dx, ty - dy
+                if 0 <= nx < width and 0 <= ny < height and frames[ny, nx] >= 0:
+                    x, y, theta = coords[ny, nx]
+                    ox, oy = naive_rotate(theta, dx, dy)
+                    samples.append(naive_bilinear(source[frames[ny, nx]], x + ox, y + oy))
+            if samples:
+                out[ty, tx] = np.mean(samples, axis=0)
+    return out
+
+
+def naive_occurrence(frames, coords, source_shape, patch_size, frame_radius):
+    """Ω*: +1 for each voxel of each match's rotated n×n×(2r+1) footprint (nearest pixel)."""
+    import math
+
+    import numpy as np
+
+    out = np.zeros(source_shape, np.int64)
+    for ty, tx in zip(*np.nonzero(frames >= 0)):
+        x, y, theta = coords[ty, tx]
+        for dx, dy in naive_window_offsets(patch_size):
+            ox, oy = naive_rotate(theta, dx, dy)
+            px, py = int(math.floor(x + ox + 0.5)), int(math.floor(y + oy + 0.5))
+            if 0 <= px < source_shape[2] and 0 <= py < source_shape[1]:
+                for frame in range(frames[ty, tx] - frame_radius, frames[ty, tx] + frame_radius + 1):
+                    if 0 <= frame < source_shape[0]:
+                        out[frame, py, px] += 1
+    return out
+
+
+def naive_exact_nnf(source, target, weights, patch_size):
+    """Brute-force best unrotated match (frame, x, y) and its cost for every target pixel."""
+    import numpy as np
+
+    frames, source_height, source_width = source.shape[:3]
+    height, width = target.shape[:2]
+    best = np.zeros((height, width), np.float64)
+    for ty in range(height):
+        for tx in range(width):
+            costs = [
+                naive_patch_cost(source, target, weights, f, sx, sy, 0.0, tx, ty, patch_size)
+                for f in range(frames) for sy in range(source_height) for sx in range(source_width)
+            ]
+            best[ty, tx] = min(costs)
+    return best
+
+
+def naive_downsample(image):
+    """Halve (H, W, C): taps (1, 3, 3, 1)/8 at 2k−1 .. 2k+2, clamped, separable, float64."""
+    import numpy as np
+
+    taps = np.array([1, 3, 3, 1]) / 8.0
+    height, width = image.shape[:2]
+    out = np.zeros(((height + 1) // 2, (width + 1) // 2) + image.shape[2:])
+    for y in range(out.shape[0]):
+        for x in range(out.shape[1]):
+            for i, wy in enumerate(taps):
+                for j, wx in enumerate(taps):
+                    fy = min(max(2 * y - 1 + i, 0), height - 1)
+                    fx = min(max(2 * x - 1 + j, 0), width - 1)
+                    out[y, x] += wy * wx * image[fy, fx]
+    return out

@@ -1,0 +1,143 @@
+import numpy as np
+import pytest
+
+from fluidymation.engine.nnf import NNF, fill_random
+from fluidymation.engine.patchmatch import build_patch_cost, patch_errors, patchmatch_pass
+from tests.naive import naive_exact_nnf, naive_patch_cost
+
+
+def make_cost(rng, *, frames=2, source=(9, 10), target=(7, 8), weight_map=False, guide_weights=(2.0, 3.0), **options):
+    source_colour = rng.random((frames,) + source + (3,)).astype(np.float32)
+    source_guides = rng.random((frames,) + source + (2,)).astype(np.float32)
+    target_colour = rng.random(target + (3,)).astype(np.float32)
+    target_guides = rng.random(target + (2,)).astype(np.float32)
+    extra = {}
+    if weight_map:
+        extra = dict(guide_weight_map=np.array([0, -1]), weight_maps=rng.random((1,) + target).astype(np.float32))
+    cost = build_patch_cost(
+        source_colour=source_colour, source_guides=source_guides, target_colour=target_colour,
+        target_guides=target_guides, colour_weights=[1.0, 0.5, 0.25], guide_weights=guide_weights, **extra, **options,
+    )
+    source = np.concatenate([source_colour, source_guides], axis=3)
+    target = np.concatenate([target_colour, target_guides], axis=2)
+    return cost, source, target, extra
+
+
+@pytest.mark.parametrize("weight_map", [False, True])
+def test_patch_errors_match_naive_cost(weight_map):
+    rng = np.random.default_rng(6)
+    cost, source, target, extra = make_cost(rng, weight_map=weight_map)
+    field = NNF(rng.integers(0, 2, (7, 8)).astype(np.int32), np.zeros((7, 8, 3), np.float32))
+    field.coords[..., 0] = rng.integers(0, 10, (7, 8))
+    field.coords[..., 1] = rng.integers(0, 9, (7, 8))
+    field.coords[::2, :, 2] = rng.uniform(-3, 3, (4, 8))
+    field.coords[:, ::3, 0] += 0.3
+    field.frame[4, 4] = -1
+    errors = patch_errors(cost, field)
+    weights = np.array([1.0, 0.5, 0.25, 2.0, 3.0])
+    for ty, tx in np.ndindex(7, 8):
+        frame = field.frame[ty, tx]
+        if frame < 0:
+            assert errors[ty, tx] == np.inf
+            continue
+        x, y, theta = field.coords[ty, tx]
+        if weight_map:
+            # guide 0 is scaled by the map at each window pixel: compare term by term
+            expected = 0.0
+            maps = extra["weight_maps"][0]
+            for dy in range(-2, 3):
+                for dx in range(-2, 3):
+                    qx, qy = tx + dx, ty + dy
+                    if 0 <= qx < 8 and 0 <= qy < 7:
+                        w = weights.copy()
+                        w[3] *= maps[qy, qx]
+                        one = np.zeros_like(target)
+                        one[qy, qx] = target[qy, qx]
+                        expected += naive_patch_cost(source, one, w, frame, x, y, theta, tx, ty, 5) - \
+                            naive_patch_cost(source, one, w * 0, frame, x, y, theta, tx, ty, 5) - \
+                            _others(source, one, w, frame, x, y, theta, tx, ty, qx, qy)
+        else:
+            expected = naive_patch_cost(source, target, weights, frame, x, y, theta, tx, ty, 5)
+        assert errors[ty, tx] == pytest.approx(expected, rel=1e-4, abs=1e-5)
+
+
+def _others(source, one, w, frame, x, y, theta, tx, ty, qx, qy):
+    """Cost of the window pixels other than (qx, qy) when the target is zero there."""
+    total = naive_patch_cost(source, one, w, frame, x, y, theta, tx, ty, 5)
+    single = 0.0
+    from tests.naive import naive_bilinear, naive_rotate
+
+    ox, oy = naive_rotate(theta, qx - tx, qy - ty)
+    value = naive_bilinear(source[frame], x + ox, y + oy)
+    single = float(np.sum(w * (value - one[qy, qx]) ** 2))
+    return total - single
+
+
+def test_orientation_term_and_opposite_swap():
+    rng = np.random.default_rng(7)
+    source_angle = rng.uniform(-3, 3, (2, 9, 10)).astype(np.float32)
+    target_angle = rng.uniform(-3, 3, (7, 8)).astype(np.float32)
+    equal = (2.0, 2.0)
+    plain, source, target, _ = make_cost(np.random.default_rng(8), guide_weights=equal)
+    swapped, *_ = make_cost(np.random.default_rng(8), guide_weights=equal, opposite_guide=[1, 0],
+                            source_angle=source_angle, target_angle=target_angle)
+    oriented, *_ = make_cost(np.random.default_rng(8), guide_weights=equal, source_angle=source_angle,
+                             target_angle=target_angle, orientation_weight=0.5, orientation_clamp=3.0)
+    with pytest.raises(ValueError, match="equal weights"):
+        make_cost(np.random.default_rng(8), opposite_guide=[1, 0], source_angle=source_angle, target_angle=target_angle)
+    field = NNF(np.ones((7, 8), np.int32), np.zeros((7, 8, 3), np.float32))
+    field.coords[..., 0] = 5
+    field.coords[..., 1] = 4
+    field.coords[..., 2] = 0.3
+    base, swap, orient = (patch_errors(c, field) for c in (plain, swapped, oriented))
+    weights = np.array([1.0, 0.5, 0.25, 2.0, 2.0])
+    source_swapped = source[..., [0, 1, 2, 4, 3]]
+    for ty, tx in [(3, 3), (0, 7), (6, 1)]:
+        opposite = np.cos(source_angle[1, 4, 5] + 0.3 - target_angle[ty, tx]) < 0
+        reference = source_swapped if opposite else source
+        assert swap[ty, tx] == pytest.approx(naive_patch_cost(reference, target, weights, 1, 5, 4, 0.3, tx, ty, 5), rel=1e-4)
+        extra = 0.0
+        for dy in range(-2, 3):
+            for dx in range(-2, 3):
+                qx, qy = tx + dx, ty + dy
+                if 0 <= qx < 8 and 0 <= qy < 7:
+                    px = 5 + np.cos(0.3) * dx - np.sin(0.3) * dy
+                    py = 4 + np.sin(0.3) * dx + np.cos(0.3) * dy
+                    sa = source_angle[1, int(min(max(py + 0.5, 0), 8)), int(min(max(px + 0.5, 0), 9))]
+                    extra += 0.5 * min(abs(np.tan(sa + 0.3 - target_angle[qy, qx])), 3.0)
+        assert orient[ty, tx] == pytest.approx(base[ty, tx] + extra, rel=1e-4)
+
+
+def test_patchmatch_finds_the_exact_nearest_neighbours_of_a_tiny_source():
+    rng = np.random.default_rng(9)
+    cost, source, target, _ = make_cost(rng, frames=2, source=(6, 6), target=(4, 5))
+    field = NNF.empty(4, 5)
+    fill_random(field, target_segment=cost.target_segment, source_segment=cost.source_segment, seed=3)
+    error = patch_errors(cost, field)
+    for iteration in range(600):  # random target, so no coherence: enough passes to sample all 72 patches
+        patchmatch_pass(cost, field, error, alpha=0.5, seed=3, salt=iteration, reverse=iteration % 2 == 1, tile_rows=2)
+    np.testing.assert_allclose(error, patch_errors(cost, field), rtol=1e-6)
+    exact = naive_exact_nnf(source, target, np.array([1.0, 0.5, 0.25, 2.0, 3.0]), 5)
+    np.testing.assert_allclose(error, exact, rtol=1e-4)
+
+
+def test_matches_stay_in_their_segment():
+    rng = np.random.default_rng(10)
+    source_segment = np.zeros((2, 9, 10), np.int32)
+    source_segment[:, :, 5:] = 1
+    target_segment = np.zeros((7, 8), np.int32)
+    target_segment[3:] = 1
+    target_segment[0, :2] = -1
+    cost, *_ = make_cost(rng, source_segment=source_segment, target_segment=target_segment)
+    field = NNF.empty(7, 8)
+    fill_random(field, target_segment=target_segment, source_segment=source_segment, seed=0)
+    error = patch_errors(cost, field)
+    before = error.copy()
+    for iteration in range(6):
+        patchmatch_pass(cost, field, error, seed=0, salt=iteration, reverse=iteration % 2 == 1)
+    assert np.all(field.frame[0, :2] == -1)
+    active = target_segment >= 0
+    assert error[active].sum() < before[active].sum()
+    for ty, tx in zip(*np.nonzero(active)):
+        x, y, _ = field.coords[ty, tx]
+        assert source_segment[field.frame[ty, tx], int(y + 0.5), int(x + 0.5)] == target_segment[ty, tx]
