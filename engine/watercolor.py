@@ -490,11 +490,15 @@ def step_wash(state, params, workspace=None):
         state.u, state.v, state.pressure, state.wet, np.float32(params.relax_rate),
         np.float32(params.relax_tolerance), int(params.relax_sweeps), work.cells, work.rows,
     )
+    np.clip(state.u, -params.max_speed, params.max_speed, out=state.u)
+    np.clip(state.v, -params.max_speed, params.max_speed, out=state.v)
     # FlowOutward
     state.pressure -= np.float32(params.edge_darkening) * (1.0 - state.wet_blur) * state.wet
     velocity = state.cell_velocity()
     # MovePigment
     largest = max(float(np.abs(state.u).max()), float(np.abs(state.v).max()))
+    if not math.isfinite(largest):
+        raise FloatingPointError("watercolor velocities are not finite; the wash parameters are unstable")
     if largest > 0.0:
         _advect_pigment(state.u, state.v, state.suspended, max(1, math.ceil(4.0 * largest)), work.flux_x, work.flux_y)
     # TransferPigment
