@@ -31,6 +31,8 @@ _COARSEST_SIDE = 12
 _COARSEST_SWEEPS = 200
 #: Over-relaxation factor of the red-black Gauss-Seidel sweeps.
 _OMEGA = 1.6
+#: Distance changes at or below this (px) are float rounding of the temporal filter.
+_STILL = 1e-4
 
 
 @parallel_kernel
@@ -62,7 +64,10 @@ def _boundary_velocity(dist_prev, dist_cur, mask, flow, state):
             norm = math.sqrt(grad_x * grad_x + grad_y * grad_y)
             if norm < 1e-6:
                 continue
-            speed = -(dist_cur[y, x] - dist_prev[y, x]) / norm
+            change = dist_cur[y, x] - dist_prev[y, x]
+            if abs(change) <= _STILL:
+                continue
+            speed = -change / norm
             flow[y, x, 0] = speed * grad_x
             flow[y, x, 1] = speed * grad_y
 

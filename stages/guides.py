@@ -161,8 +161,7 @@ class GuideCache:
 
     def write(self, channel: str, index: int, array: np.ndarray) -> None:
         view = self._map(channel, index, "r+")
-        view[...] = array
-        view.flush()
+        view[...] = array  # stays in the page cache; other mappings see it at once
         del view
 
     def read(self, channel: str, index: int) -> np.ndarray:
