@@ -16,7 +16,9 @@ pseudocode are fixed (``+μB`` in the velocity update, ``δ = −ξ·div`` in th
 relaxation). Axes: ``x`` is the column and grows to the right, ``y`` is the row and
 grows downwards; a positive ``u`` moves water to the right, a positive ``v`` down.
 
-Every parallel loop writes its own rows, so results do not depend on the thread count.
+The kernels are serial: each launch does little work (a relaxation sweep is a few
+hundred microseconds at 256²), so thread start-up and barriers would cost more than they
+save on a busy machine, and serial loops make the result independent of the thread count.
 """
 
 from __future__ import annotations
@@ -25,10 +27,9 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-from numba import prange
 from scipy import ndimage
 
-from fluidymation.engine._jit import kernel, parallel_kernel
+from fluidymation.engine._jit import kernel
 
 __all__ = [
     "WashParams",
@@ -237,39 +238,39 @@ def _as_field(value, name, shape=None):
 # --------------------------------------------------------------------------- kernels
 
 
-@parallel_kernel
+@kernel
 def _zero_dry_faces(u, v, wet):
     height, width = wet.shape
-    for y in prange(height):
+    for y in range(height):
         u[y, 0] = 0.0
         u[y, width] = 0.0
         for x in range(1, width):
             if wet[y, x - 1] == 0 or wet[y, x] == 0:
                 u[y, x] = 0.0
-    for y in prange(height + 1):
+    for y in range(height + 1):
         for x in range(width):
             if y == 0 or y == height or wet[y - 1, x] == 0 or wet[y, x] == 0:
                 v[y, x] = 0.0
 
 
-@parallel_kernel
+@kernel
 def _apply_slope(u, v, paper_height, wet, slope):
     height, width = wet.shape
-    for y in prange(height):
+    for y in range(height):
         for x in range(1, width):
             if wet[y, x - 1] != 0 and wet[y, x] != 0:
                 u[y, x] -= slope * (paper_height[y, x] - paper_height[y, x - 1])
-    for y in prange(1, height):
+    for y in range(1, height):
         for x in range(width):
             if wet[y - 1, x] != 0 and wet[y, x] != 0:
                 v[y, x] -= slope * (paper_height[y, x] - paper_height[y - 1, x])
 
 
-@parallel_kernel
+@kernel
 def _advance_velocities(u, v, pressure, wet, dt, viscosity, drag, max_speed, u_out, v_out):
     """One forward-Euler substep of the shallow-water momentum equation."""
     height, width = wet.shape
-    for y in prange(height):
+    for y in range(height):
         for x in range(width + 1):
             if x == 0 or x == width or wet[y, x - 1] == 0 or wet[y, x] == 0:
                 u_out[y, x] = 0.0
@@ -285,7 +286,7 @@ def _advance_velocities(u, v, pressure, wet, dt, viscosity, drag, max_speed, u_o
             diffusion = u[y, x + 1] + u[y, x - 1] + up + down - 4.0 * here
             value = here + dt * (advection + viscosity * diffusion + pressure[y, x - 1] - pressure[y, x] - drag * here)
             u_out[y, x] = min(max(value, -max_speed), max_speed)
-    for y in prange(height + 1):
+    for y in range(height + 1):
         for x in range(width):
             if y == 0 or y == height or wet[y - 1, x] == 0 or wet[y, x] == 0:
                 v_out[y, x] = 0.0
@@ -303,12 +304,12 @@ def _advance_velocities(u, v, pressure, wet, dt, viscosity, drag, max_speed, u_o
             v_out[y, x] = min(max(value, -max_speed), max_speed)
 
 
-@parallel_kernel
+@kernel
 def _relax_divergence(u, v, pressure, wet, rate, tolerance, max_sweeps, delta, row_max):
     """Jacobi sweeps that remove divergence: δ = −ξ·div moves into p and the faces."""
     height, width = wet.shape
     for _ in range(max_sweeps):
-        for y in prange(height):
+        for y in range(height):
             largest = 0.0
             for x in range(width):
                 if wet[y, x] != 0:
@@ -318,13 +319,13 @@ def _relax_divergence(u, v, pressure, wet, rate, tolerance, max_sweeps, delta, r
                 else:
                     delta[y, x] = 0.0
             row_max[y] = largest
-        for y in prange(height):
+        for y in range(height):
             for x in range(width):
                 pressure[y, x] += delta[y, x]
             for x in range(1, width):
                 if wet[y, x - 1] != 0 and wet[y, x] != 0:
                     u[y, x] += delta[y, x - 1] - delta[y, x]
-        for y in prange(1, height):
+        for y in range(1, height):
             for x in range(width):
                 if wet[y - 1, x] != 0 and wet[y, x] != 0:
                     v[y, x] += delta[y - 1, x] - delta[y, x]
@@ -332,29 +333,29 @@ def _relax_divergence(u, v, pressure, wet, rate, tolerance, max_sweeps, delta, r
             break
 
 
-@parallel_kernel
+@kernel
 def _advect_pigment(u, v, pigment, substeps, flux_x, flux_y):
     """Upwind flux-form advection: conserves mass, keeps pigment non-negative."""
     height, width = pigment.shape
     dt = 1.0 / substeps
     for _ in range(substeps):
-        for y in prange(height):
+        for y in range(height):
             for x in range(1, width):
                 face = u[y, x]
                 flux_x[y, x] = dt * (max(face, 0.0) * pigment[y, x - 1] - max(-face, 0.0) * pigment[y, x])
-        for y in prange(1, height):
+        for y in range(1, height):
             for x in range(width):
                 face = v[y, x]
                 flux_y[y, x] = dt * (max(face, 0.0) * pigment[y - 1, x] - max(-face, 0.0) * pigment[y, x])
-        for y in prange(height):
+        for y in range(height):
             for x in range(width):
                 pigment[y, x] += flux_x[y, x] - flux_x[y, x + 1] + flux_y[y, x] - flux_y[y + 1, x]
 
 
-@parallel_kernel
+@kernel
 def _transfer_pigment(suspended, deposited, paper_height, wet, density, staining, granulation):
     height, width = wet.shape
-    for y in prange(height):
+    for y in range(height):
         for x in range(width):
             if wet[y, x] == 0:
                 continue
@@ -379,13 +380,13 @@ def _capillary_share(source, target, target_capacity, diffuse_min, receive_min):
     return 0.0
 
 
-@parallel_kernel
+@kernel
 def _capillary_flow(
     saturation, capacity, wet, water, absorption, use_water, diffuse_min, receive_min, wet_threshold, snapshot, grown_rows
 ):
     """Absorb water into the paper, diffuse it along the fibres, wet the cells it reaches."""
     height, width = wet.shape
-    for y in prange(height):
+    for y in range(height):
         for x in range(width):
             if wet[y, x] != 0:
                 amount = max(0.0, min(absorption, capacity[y, x] - saturation[y, x]))
@@ -394,7 +395,7 @@ def _capillary_flow(
                     water[y, x] -= amount
                 saturation[y, x] += amount
             snapshot[y, x] = saturation[y, x]
-    for y in prange(height):
+    for y in range(height):
         for x in range(width):
             here = snapshot[y, x]
             cap = capacity[y, x]
@@ -408,7 +409,7 @@ def _capillary_flow(
                 net += _capillary_share(there, here, cap, diffuse_min, receive_min)
                 net -= _capillary_share(here, there, capacity[ny, nx], diffuse_min, receive_min)
             saturation[y, x] = here + net
-    for y in prange(height):
+    for y in range(height):
         grown = 0
         for x in range(width):
             if wet[y, x] == 0 and saturation[y, x] > wet_threshold:
@@ -417,14 +418,14 @@ def _capillary_flow(
         grown_rows[y] = grown
 
 
-@parallel_kernel
+@kernel
 def _evaporate(
     wet, wet_blur, water, saturation, suspended, deposited, pressure, rate, edge_boost, saturation_decay, dry_saturation,
     dried_rows,
 ):
     """Standing water evaporates (faster near the wet edge); drained cells dry out."""
     height, width = wet.shape
-    for y in prange(height):
+    for y in range(height):
         dried = 0
         for x in range(width):
             if wet[y, x] != 0 and water[y, x] > 0.0:

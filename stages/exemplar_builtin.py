@@ -290,9 +290,9 @@ def _crumble_frames(params: Params):
         paper_height=paper_height,
         seed=int(rng.integers(2**31)),
         frames=params.frames,
-        fragment_size=6.0 * scale,
+        fragment_size=max(2.0, 6.0 * scale),
         remaining=0.1 + 0.4 * params.wetness,
-        max_speed=6.0 * scale,
+        max_speed=max(2.0, 6.0 * scale),
     ):
         linear = watercolor.km_render(thickness, absorption, scattering, paper_rgb)
         yield watercolor.linear_to_srgb(linear), mask, flow

@@ -1,0 +1,54 @@
+import json
+
+import imageio.v3 as iio
+import numpy as np
+import pytest
+
+from fluidymation.stages import exemplar_builtin as eb
+
+
+def test_list_shows_every_preset_with_defaults(cli):
+    code, out, _ = cli("exemplar", "list")
+    assert code == 0
+    for name in eb.PRESETS:
+        assert f"{name}: {eb.PRESETS[name].description}" in out
+    assert "size=256x256" in out and "frames=60" in out
+
+
+@pytest.mark.parametrize("size", [["40x32"], ["40", "32"]])
+def test_make_writes_frames_masks_flow_and_record(cli, tmp_path, size):
+    out_dir = tmp_path / "bloom"
+    code, _, err = cli("-q", "exemplar", "make", "watercolor-bloom", "-o", out_dir, "--seed", 3, "--size", *size,
+                       "--frames", 4, "--color", "#aa3300", "--cache", tmp_path / "cache")
+    assert code == 0, err
+    assert sorted(p.name for p in (out_dir / "rgb").iterdir()) == [f"{i:05d}.png" for i in range(4)]
+    rgb = iio.imread(out_dir / "rgb" / "00003.png")
+    mask = iio.imread(out_dir / "mask" / "00003.png")
+    flow = np.load(out_dir / "flow" / "00003.npy")
+    assert rgb.shape == (32, 40, 3) and mask.shape == (32, 40)
+    assert set(np.unique(mask)) == {0, 255}
+    assert flow.shape == (32, 40, 2) and flow.dtype == np.float32
+    record = json.loads((out_dir / "exemplar.json").read_text())
+    assert record["name"] == "watercolor-bloom" and record["frames"] == 4 and record["size"] == [40, 32]
+    assert record["params"]["seed"] == 3 and record["params"]["color"] == "#aa3300"
+    expected = eb.make_builtin_exemplar(eb.Params(preset="watercolor-bloom", seed=3, size=(40, 32), frames=4,
+                                                  color="#aa3300", wetness=0.5))
+    assert np.array_equal(mask > 0, expected.mask[3])
+    assert np.array_equal(flow, expected.flow[3])
+
+
+def test_unknown_name_lists_the_valid_ones(cli, tmp_path):
+    code, _, err = cli("exemplar", "make", "oil-paint", "-o", tmp_path / "x")
+    assert code == 2
+    assert "oil-paint" in err and all(name in err for name in eb.PRESETS)
+    assert not (tmp_path / "x").exists()
+
+
+@pytest.mark.parametrize(
+    "option, message",
+    [(["--size", "1", "2", "3"], "--size"), (["--color", "red"], "#rrggbb"), (["--frames", "1"], "frames")],
+)
+def test_bad_options_exit_2_with_a_message(cli, tmp_path, option, message):
+    code, _, err = cli("exemplar", "make", "crumble", "-o", tmp_path / "x", "--no-cache", *option)
+    assert code == 2
+    assert message in err
