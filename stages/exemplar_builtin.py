@@ -205,7 +205,7 @@ def _bloom_frames(params: Params):
     paper_height, capacity, _ = _paper(params)
     centre = (height / 2 + rng.uniform(-0.05, 0.05) * height, width / 2 + rng.uniform(-0.05, 0.05) * width)
     wet = _noisy_disk((height, width), (height / 2, width / 2), 0.47 * min(width, height), rng, softness=1.0) > 0.5
-    drop = _noisy_disk((height, width), centre, 0.1 * min(width, height), rng, softness=2.0 * scale)
+    drop = _noisy_disk((height, width), centre, 0.1 * min(width, height), rng, roughness=0.25, softness=2.0 * scale)
     pigment = 0.5
     state = watercolor.new_wash(
         height=paper_height,
@@ -215,8 +215,8 @@ def _bloom_frames(params: Params):
         suspended=drop * pigment,
         saturation=wet * np.float32(0.3),
     )
-    wash = watercolor.WashParams(drag=0.5, slope=1.0, edge_darkening=0.01, density=0.008, granulation=0.8)
-    return _watercolor_frames(params, state, wash, reference=pigment, steps=round(300 * scale))
+    wash = watercolor.WashParams(drag=0.5, slope=2.0, edge_darkening=0.01, density=0.008, granulation=0.8)
+    return _watercolor_frames(params, state, wash, reference=0.7 * pigment, steps=round(700 * scale))
 
 
 def _dry_frames(params: Params):
