@@ -237,3 +237,29 @@ def naive_downsample(image):
                     fx = min(max(2 * x - 1 + j, 0), width - 1)
                     out[y, x] += wy * wx * image[fy, fx]
     return out
+
+
+# --- stylize (issue 6): SHIFTNNF, temporal modulation ---------------
+
+
+def naive_shift_frames(frames, coords, motion, target_angle, ext_plus, ext_minus, source_angle):
+    """Shifted source frame per target pixel by brute force over every Δi (smallest |Δi| on ties)."""
+    import math
+
+    import numpy as np
+
+    count, height, width = ext_plus.shape
+    out = np.array(frames, copy=True)
+    for ty, tx in np.ndindex(frames.shape):
+        i = int(frames[ty, tx])
+        if i < 0:
+            continue
+        sx = min(max(int(math.floor(coords[ty, tx, 0] + 0.5)), 0), width - 1)
+        sy = min(max(int(math.floor(coords[ty, tx, 1] + 0.5)), 0), height - 1)
+        turn = float(source_angle[i, sy, sx]) + float(coords[ty, tx, 2]) - float(target_angle[ty, tx])
+        if math.cos(turn) < 0:
+            options = [(abs(motion[ty, tx] - (ext_minus[k, sy, sx] - ext_minus[i, sy, sx])), i - k, k) for k in range(i, -1, -1)]
+        else:
+            options = [(abs(motion[ty, tx] - (ext_plus[k, sy, sx] - ext_plus[i, sy, sx])), k - i, k) for k in range(i, count)]
+        out[ty, tx] = min(options)[2]
+    return out

@@ -1,0 +1,157 @@
+"""Reuse of the previous frame's field: SHIFTNNF and the temporal modulation m(q).
+
+:func:`shift_nnf` moves every match ``(i, x, y, θ)`` of frame ``j − 1`` forward (or, where
+the rotated source flow opposes the target flow, backward) in source time by the ``Δi``
+whose source motion amount best matches the target's motion amount between frames
+``j − 1`` and ``j`` (paper section 3.4; ALGORITHM.md, "Multi-scale and reuse between
+frames"). :func:`temporal_modulation` is the per-pixel factor m(q) of the temporal term:
+0 where q was outside the previous mask, else 1 when the target and source distances
+differ by at most ``lower`` and 0 when by ``upper`` or more, smooth in between.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import prange
+
+from fluidymation.engine._jit import parallel_kernel
+from fluidymation.engine.nnf import NNF
+
+
+@parallel_kernel
+def _shift(frame_in, coords_in, target_motion, target_angle, source_ext_plus, source_ext_minus, source_angle, frame_out):
+    height, width = frame_in.shape
+    frames, source_height, source_width = source_ext_plus.shape
+    for ty in prange(height):
+        for tx in range(width):
+            frame = frame_in[ty, tx]
+            if frame < 0:
+                frame_out[ty, tx] = -1
+                continue
+            sx = min(max(int(coords_in[ty, tx, 0] + 0.5), 0), source_width - 1)
+            sy = min(max(int(coords_in[ty, tx, 1] + 0.5), 0), source_height - 1)
+            theta = coords_in[ty, tx, 2]
+            opposite = math.cos(source_angle[frame, sy, sx] + theta - target_angle[ty, tx]) < 0.0
+            wanted = target_motion[ty, tx]
+            best_frame = frame
+            best_gap = abs(wanted)
+            if opposite:
+                start = source_ext_minus[frame, sy, sx]
+                for candidate in range(frame - 1, -1, -1):
+                    gap = abs(wanted - (source_ext_minus[candidate, sy, sx] - start))
+                    if gap < best_gap:
+                        best_gap = gap
+                        best_frame = candidate
+            else:
+                start = source_ext_plus[frame, sy, sx]
+                for candidate in range(frame + 1, frames):
+                    gap = abs(wanted - (source_ext_plus[candidate, sy, sx] - start))
+                    if gap < best_gap:
+                        best_gap = gap
+                        best_frame = candidate
+            frame_out[ty, tx] = best_frame
+
+
+def shift_nnf(nnf, *, target_motion, target_angle, source_ext_plus, source_ext_minus, source_angle):
+    """SHIFTNNF: the previous frame's field moved along source time to match the target motion.
+
+    For each match ``(i, x, y, θ)`` at target pixel q (source values read at the nearest
+    pixel to ``(x, y)``): if ``cos(S_dir(i, p) + θ − T_dir(q)) ≥ 0`` find ``Δi ≥ 0``
+    minimising ``|target_motion(q) − (S_ext+(i + Δi, p) − S_ext+(i, p))|``, otherwise
+    ``Δi ≤ 0`` minimising ``|target_motion(q) − (S_ext−(i + Δi, p) − S_ext−(i, p))|``;
+    ties go to the smallest ``|Δi|``. ``x, y, θ`` are kept.
+
+    Parameters
+    ----------
+    nnf : NNF
+        The previous frame's field (H, W).
+    target_motion : ndarray, shape (H, W), float32
+        ``T_ext+(j) − T_ext+(j − 1)``: how far the target moved at each pixel.
+    target_angle : ndarray, shape (H, W), float32
+        Target flow orientation (radians) of frame j.
+    source_ext_plus, source_ext_minus, source_angle : ndarray, shape (T, Hs, Ws), float32
+
+    Returns
+    -------
+    NNF
+        A new field; unmatched pixels (frame -1) stay unmatched.
+    """
+    height, width = nnf.shape
+    source_shape = np.shape(source_ext_plus)
+    for name, value, shape in (
+        ("target_motion", target_motion, (height, width)), ("target_angle", target_angle, (height, width)),
+        ("source_ext_minus", source_ext_minus, source_shape), ("source_angle", source_angle, source_shape),
+    ):
+        if np.shape(value) != shape:
+            raise ValueError(f"{name} must have shape {shape}, got {np.shape(value)}")
+    if len(source_shape) != 3:
+        raise ValueError(f"source_ext_plus must have shape (T, Hs, Ws), got {source_shape}")
+    frame_out = np.empty((height, width), np.int32)
+    _shift(
+        nnf.frame, nnf.coords, np.ascontiguousarray(target_motion, np.float32),
+        np.ascontiguousarray(target_angle, np.float32), np.ascontiguousarray(source_ext_plus, np.float32),
+        np.ascontiguousarray(source_ext_minus, np.float32), np.ascontiguousarray(source_angle, np.float32), frame_out,
+    )
+    return NNF(frame_out, nnf.coords.copy())
+
+
+@parallel_kernel
+def _modulation(frame_in, coords_in, target_dist, source_dist, previous_mask, lower, upper, out):
+    height, width = frame_in.shape
+    source_height = source_dist.shape[1]
+    source_width = source_dist.shape[2]
+    span = upper - lower
+    for ty in prange(height):
+        for tx in range(width):
+            frame = frame_in[ty, tx]
+            if frame < 0 or not previous_mask[ty, tx]:
+                out[ty, tx] = 0.0
+                continue
+            sx = min(max(int(coords_in[ty, tx, 0] + 0.5), 0), source_width - 1)
+            sy = min(max(int(coords_in[ty, tx, 1] + 0.5), 0), source_height - 1)
+            gap = abs(target_dist[ty, tx] - source_dist[frame, sy, sx])
+            if gap <= lower:
+                out[ty, tx] = 1.0
+            elif gap >= upper or span <= 0.0:
+                out[ty, tx] = 0.0
+            else:
+                t = (gap - lower) / span
+                out[ty, tx] = 1.0 - t * t * (3.0 - 2.0 * t)
+
+
+def temporal_modulation(nnf, *, target_dist, source_dist, previous_mask, lower, upper):
+    """m(q): how much to trust the temporal guide at each target pixel.
+
+    Parameters
+    ----------
+    nnf : NNF
+        The shifted field NNF_prev (H, W).
+    target_dist : ndarray, shape (H, W), float32
+        Target distance of frame j (e.g. signed distance clamped at the border width).
+    source_dist : ndarray, shape (T, Hs, Ws), float32
+        Source distance in the same units, read at the nearest pixel of each match.
+    previous_mask : ndarray of bool, shape (H, W)
+        Where the target was in frame j − 1.
+    lower, upper : float
+        m = 1 for ``|T_dist − S_dist| ≤ lower``, 0 for ``≥ upper``, smoothstep between.
+
+    Returns
+    -------
+    ndarray, shape (H, W), float32 in [0, 1]
+    """
+    if lower < 0 or upper < lower:
+        raise ValueError(f"need 0 ≤ lower ≤ upper, got lower={lower}, upper={upper}")
+    height, width = nnf.shape
+    if np.shape(target_dist) != (height, width) or np.shape(previous_mask) != (height, width):
+        raise ValueError(f"target_dist and previous_mask must have shape {(height, width)}")
+    if np.ndim(source_dist) != 3:
+        raise ValueError(f"source_dist must have shape (T, Hs, Ws), got {np.shape(source_dist)}")
+    out = np.empty((height, width), np.float32)
+    _modulation(
+        nnf.frame, nnf.coords, np.ascontiguousarray(target_dist, np.float32),
+        np.ascontiguousarray(source_dist, np.float32), np.ascontiguousarray(previous_mask, np.bool_),
+        np.float32(lower), np.float32(upper), out,
+    )
+    return out

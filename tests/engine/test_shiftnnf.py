@@ -1,0 +1,87 @@
+import math
+
+import numpy as np
+import pytest
+
+from fluidymation.engine.nnf import NNF
+from fluidymation.engine.shiftnnf import shift_nnf, temporal_modulation
+from tests.naive import naive_shift_frames
+
+
+def _single(frame, x, y, theta):
+    return NNF(np.array([[frame]], np.int32), np.array([[[x, y, theta]]], np.float32))
+
+
+def _ramp_source(frames=6, size=4, speed=2.0):
+    """Source whose ext+ grows by ``speed`` per frame and ext− shrinks by it; flow along +x."""
+    steps = np.arange(frames, dtype=np.float32)[:, None, None] * np.ones((1, size, size), np.float32)
+    return speed * steps, speed * (frames - 1 - steps), np.zeros((frames, size, size), np.float32)
+
+
+def test_forward_shift_matches_the_target_motion_exactly():
+    plus, minus, angle = _ramp_source()
+    shifted = shift_nnf(_single(1, 2.0, 1.0, 0.0), target_motion=np.array([[4.0]], np.float32),
+                        target_angle=np.zeros((1, 1), np.float32), source_ext_plus=plus,
+                        source_ext_minus=minus, source_angle=angle)
+    assert shifted.frame[0, 0] == 3  # moved 2 px per source frame: 4 px is 2 frames on
+    np.testing.assert_array_equal(shifted.coords, [[[2.0, 1.0, 0.0]]])
+
+
+def test_opposite_flow_shifts_backward_with_ext_minus():
+    plus, minus, angle = _ramp_source()
+    # target flows along −x, the unrotated source along +x: roughly opposite
+    shifted = shift_nnf(_single(4, 1.0, 1.0, 0.0), target_motion=np.array([[6.0]], np.float32),
+                        target_angle=np.full((1, 1), math.pi, np.float32), source_ext_plus=plus,
+                        source_ext_minus=minus, source_angle=angle)
+    assert shifted.frame[0, 0] == 1
+    # the same match rotated by π follows the target: forward again, clamped at the last frame
+    shifted = shift_nnf(_single(4, 1.0, 1.0, math.pi), target_motion=np.array([[6.0]], np.float32),
+                        target_angle=np.full((1, 1), math.pi, np.float32), source_ext_plus=plus,
+                        source_ext_minus=minus, source_angle=angle)
+    assert shifted.frame[0, 0] == 5
+
+
+def test_no_target_motion_and_unmatched_pixels_stay():
+    plus, minus, angle = _ramp_source()
+    nnf = NNF(np.array([[2, -1]], np.int32), np.array([[[1, 1, 0], [0, 0, 0]]], np.float32))
+    shifted = shift_nnf(nnf, target_motion=np.zeros((1, 2), np.float32), target_angle=np.zeros((1, 2), np.float32),
+                        source_ext_plus=plus, source_ext_minus=minus, source_angle=angle)
+    np.testing.assert_array_equal(shifted.frame, [[2, -1]])
+
+
+def test_shift_agrees_with_the_naive_search():
+    rng = np.random.default_rng(3)
+    frames, height, width = 7, 6, 5
+    plus = np.cumsum(rng.uniform(0, 2, (frames, height, width)), axis=0).astype(np.float32)
+    minus = np.cumsum(rng.uniform(0, 2, (frames, height, width))[::-1], axis=0)[::-1].astype(np.float32)
+    source_angle = rng.uniform(-np.pi, np.pi, (frames, height, width)).astype(np.float32)
+    shape = (9, 8)
+    frame = rng.integers(-1, frames, shape).astype(np.int32)
+    coords = np.stack([rng.uniform(-1, width, shape), rng.uniform(-1, height, shape),
+                       rng.uniform(-np.pi, np.pi, shape)], axis=2).astype(np.float32)
+    motion = rng.uniform(0, 6, shape).astype(np.float32)
+    target_angle = rng.uniform(-np.pi, np.pi, shape).astype(np.float32)
+    shifted = shift_nnf(NNF(frame, coords), target_motion=motion, target_angle=target_angle,
+                        source_ext_plus=plus, source_ext_minus=np.ascontiguousarray(minus), source_angle=source_angle)
+    expected = naive_shift_frames(frame, coords, motion, target_angle, plus, minus, source_angle)
+    np.testing.assert_array_equal(shifted.frame, expected)
+
+
+def test_modulation_is_one_when_distances_agree_and_zero_outside_the_previous_mask():
+    source_dist = np.array([[[0.0, 5.0, 10.0, 3.0]]], np.float32)
+    nnf = NNF(np.zeros((1, 4), np.int32), np.array([[[0, 0, 0], [1, 0, 0], [2, 0, 0], [3, 0, 0]]], np.float32))
+    target_dist = np.array([[0.5, 5.0, 4.0, 3.0]], np.float32)
+    previous = np.array([[True, True, True, False]])
+    m = temporal_modulation(nnf, target_dist=target_dist, source_dist=source_dist, previous_mask=previous,
+                            lower=1.0, upper=4.0)
+    np.testing.assert_allclose(m, [[1.0, 1.0, 0.0, 0.0]])
+    halfway = temporal_modulation(nnf, target_dist=np.array([[2.5, 5, 10, 3]], np.float32), source_dist=source_dist,
+                                  previous_mask=previous, lower=1.0, upper=4.0)
+    assert halfway[0, 0] == pytest.approx(0.5)
+
+
+def test_bad_shapes_are_refused():
+    plus, minus, angle = _ramp_source()
+    with pytest.raises(ValueError):
+        shift_nnf(_single(0, 0, 0, 0), target_motion=np.zeros((2, 2), np.float32), target_angle=np.zeros((1, 1), np.float32),
+                  source_ext_plus=plus, source_ext_minus=minus, source_angle=angle)
