@@ -8,5 +8,5 @@ from tqdm import tqdm
 
 
 def progress(total: int, description: str, *, quiet: bool = False, unit: str = "frame") -> tqdm:
-    return tqdm(total=total, desc=description, unit=unit, file=sys.stderr, disable=quiet, delay=1.0,
+    return tqdm(total=total, desc=description, unit=unit, file=sys.stderr, disable=True if quiet else None, delay=1.0,
                 dynamic_ncols=True, leave=False)

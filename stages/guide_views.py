@@ -1,6 +1,6 @@
 """Per-frame PNG views (and optionally raw arrays) of the guides of a mask sequence.
 
-Layout under the output directory, files numbered from the first requested frame::
+Layout under the output directory, files numbered by frame index in the sequence::
 
     flow/00000.png       hue = direction, brightness = |flow| (paper fig. 4b)
     ext_plus/00000.png   grey ramp, 0 .. largest ext± of the sequence
@@ -108,7 +108,8 @@ def write_guide_views(
     """Compute the guides of a mask sequence and write views of the requested frames.
 
     The guides are always computed over the whole sequence (ext+ starts at its first
-    frame, ext− at its last), then frames ``frames`` are written, numbered from 0.
+    frame, ext− at its last), then frames ``frames`` are written, each file numbered by its frame index
+    (as the masks are), so a partial write lines up with a full one.
 
     Parameters
     ----------
@@ -153,7 +154,7 @@ def write_guide_views(
             given_flow=given_flow,
             progress=report,
         )
-        for number, index in enumerate(selected):
-            _write_frame(out_dir, number, cache.frame(index), cache.meta, raw)
-            report(2 * frame_count + number + 1, total)
+        for done, index in enumerate(selected, start=1):
+            _write_frame(out_dir, index, cache.frame(index), cache.meta, raw)
+            report(2 * frame_count + done, total)
         return dict(cache.meta, frames=[selected.start, selected.stop])

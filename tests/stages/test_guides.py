@@ -170,11 +170,11 @@ def test_write_guide_views_writes_pngs_and_raw_arrays_for_the_range(tmp_path):
     summary = write_guide_views(masks, 8, tmp_path / "out", params=PARAMS, frames=(2, 5), raw=True)
     assert summary["frames"] == [2, 5]
     for channel in ("flow", "ext_plus", "ext_minus", "shape", "dist", "segments"):
-        assert sorted(p.name for p in (tmp_path / "out" / channel).glob("*.png")) == ["00000.png", "00001.png", "00002.png"]
-    flow = np.load(tmp_path / "out" / "flow" / "00001.npy")
+        assert sorted(p.name for p in (tmp_path / "out" / channel).glob("*.png")) == ["00002.png", "00003.png", "00004.png"]
+    flow = np.load(tmp_path / "out" / "flow" / "00003.npy")
     assert flow.shape == (HEIGHT, WIDTH, 2) and flow.dtype == np.float32
     for channel in ("ext_plus", "ext_minus", "dist", "shape"):
-        array = np.load(tmp_path / "out" / channel / "00002.npy")
+        array = np.load(tmp_path / "out" / channel / "00004.npy")
         assert array.shape == (HEIGHT, WIDTH) and array.dtype == np.float32
     assert not list((tmp_path / "out").glob(".guides-cache-*"))
     with pytest.raises(StageError, match="frames"):

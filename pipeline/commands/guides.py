@@ -1,0 +1,76 @@
+"""``fluidymation guides SCENE --layer NAME``: views (and arrays) of a layer's guidance channels."""
+
+from __future__ import annotations
+
+import dataclasses
+from pathlib import Path
+
+from fluidymation.errors import InputError, SceneError, StageError
+from fluidymation.pipeline.progress import progress
+from fluidymation.pipeline.resolve import parse_window, plan_scene
+from fluidymation.pipeline.scene import load_scene
+from fluidymation.stages import guides
+from fluidymation.stages.guide_views import write_guide_views
+from fluidymation.stages.rasterize import Params as RasterParams
+from fluidymation.stages.rasterize import rasterize_frame
+from fluidymation.stages.vector.svg_input import sequence_files
+
+
+def add_parser(subparsers) -> None:
+    parser = subparsers.add_parser(
+        "guides", help="write views of a layer's guidance channels (flow, ext+, ext-, shape, distance)",
+        description="Compute a layer's guidance channels over the whole scene range and write PNG views "
+                    "per frame: flow/ (hue = direction, brightness = speed), ext_plus/, ext_minus/, shape/, "
+                    "dist/, segments/. With --raw also the arrays as .npy.")
+    parser.add_argument("scene", help="the scene's YAML file")
+    parser.add_argument("--layer", required=True, metavar="NAME", help="the scene layer")
+    parser.add_argument("-o", "--output", metavar="DIR", help="output folder (default: <output.dir>/guides/<layer>)")
+    parser.add_argument("--frames", metavar="A:B", help="only write scene frames A to B (B exclusive)")
+    parser.add_argument("--raw", action="store_true", help="also write flow/, ext_plus/, ext_minus/, dist/, "
+                                                           "shape/ arrays as .npy (float32, flow in px/frame)")
+    parser.add_argument("--flow", metavar="PATTERN", help="use given flows (.npy or Middlebury .flo, e.g. "
+                                                          "flow/%%05d.flo) instead of estimating them from the masks")
+    parser.set_defaults(run=run)
+
+
+def run(args) -> int:
+    plan = plan_scene(load_scene(args.scene))
+    layer = plan.layer(args.layer)
+    window = plan.frames(parse_window(args.frames))
+    out_dir = Path(args.output) if args.output else plan.scene.output.dir / "guides" / layer.dirname
+    raster = RasterParams(size=plan.size, fps=plan.fps)
+    params = guide_params(layer.spec.params, scale=plan.size[0] / plan.source.width, scene=plan.scene.path)
+    given = given_flows(args.flow, plan.frame_count) if args.flow else None
+
+    def mask(index: int):
+        return rasterize_frame(plan.source, layer.vector_layers, plan.start + index, raster).coverage
+
+    with progress(1, f"guides {layer.name}", quiet=args.quiet, unit="step") as bar:
+        def report(done: int, total: int) -> None:
+            bar.total = total
+            bar.n = done
+            bar.refresh()
+
+        write_guide_views(mask, plan.frame_count, out_dir, params=params, raw=args.raw, given_flow=given,
+                          frames=(window.start - plan.start, window.stop - plan.start), progress=report)
+    if not args.quiet:
+        print(f"wrote guide views of frames {window.start}:{window.stop} of layer {layer.name} to {out_dir}")
+    return 0
+
+
+def guide_params(layer_params: dict, *, scale: float, scene: Path) -> guides.Params:
+    """The guides stage's parameters: defaults, overridden by the layer's ``params`` of the same names."""
+    names = {field.name for field in dataclasses.fields(guides.Params)} - {"scale"}
+    chosen = {key: value for key, value in layer_params.items() if key in names}
+    try:
+        return guides.Params(**chosen, scale=scale)
+    except (TypeError, ValueError, StageError) as exc:
+        raise SceneError(f"{scene}: layer params: {exc}") from None
+
+
+def given_flows(pattern: str, count: int) -> list[Path]:
+    """The flow files of a pattern, one per scene frame of the range."""
+    files = sequence_files(Path(pattern))
+    if len(files) < count:
+        raise InputError(f"{pattern}: {len(files)} flow files for {count} frames")
+    return files[:count]

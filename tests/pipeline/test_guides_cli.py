@@ -1,0 +1,42 @@
+"""`fluidymation guides` on a tiny scene: files, numbering, raw arrays, motion direction."""
+
+import numpy as np
+
+from tests.pipeline.test_bad_input import scene_for
+
+
+def moving_disk_scene(tmp_path, frames=16):
+    for index in range(frames):
+        (tmp_path / f"f{index:02d}.svg").write_text(
+            f'<svg xmlns="http://www.w3.org/2000/svg" width="64" height="48"><g id="disk">'
+            f'<circle cx="{12 + 2 * index}" cy="24" r="8"/></g></svg>')
+    return scene_for(tmp_path, "f%02d.svg", "layers:\n  - name: disk\n    params: {blur_sigma: 1, "
+                                            "shape_radius: 4, border_width: 3}\n")
+
+
+def test_guides_writes_views_and_raw_arrays_numbered_by_frame(cli, tmp_path):
+    scene = moving_disk_scene(tmp_path)
+    code, out, err = cli("-q", "guides", scene, "--layer", "disk", "--frames", "7:10", "--raw", "-o", tmp_path / "g")
+    assert code == 0, err
+    for channel in ("flow", "ext_plus", "ext_minus", "shape", "dist", "segments"):
+        assert sorted(p.name for p in (tmp_path / "g" / channel).glob("*.png")) == ["00007.png", "00008.png", "00009.png"]
+    flow = np.load(tmp_path / "g" / "flow" / "00008.npy")
+    assert flow.shape == (48, 64, 2) and flow.dtype == np.float32
+    leading, trailing = flow[24, 36], flow[24, 20]  # the disk at frame 8 spans x 20..36 at y 24
+    for edge in (leading, trailing):  # moving right at 2 px/frame
+        assert 1.4 < edge[0] < 2.6 and abs(edge[1]) < 0.4
+
+
+def test_guides_default_folder_and_unknown_layer(cli, tmp_path):
+    scene = moving_disk_scene(tmp_path, frames=3)
+    assert cli("-q", "guides", scene, "--layer", "disk")[0] == 0
+    assert (tmp_path / "out" / "scene" / "guides" / "disk" / "flow" / "00002.png").is_file()
+    code, _, err = cli("guides", scene, "--layer", "nope")
+    assert code == 2 and "no layer called 'nope'" in err
+
+
+def test_guides_bad_layer_param(cli, tmp_path):
+    scene = scene_for(tmp_path, "f%02d.svg", "layers:\n  - name: disk\n    params: {blur_sigma: -1}\n")
+    (tmp_path / "f00.svg").write_text('<svg xmlns="http://www.w3.org/2000/svg" width="8" height="8"><g id="disk"/></svg>')
+    code, _, err = cli("guides", scene, "--layer", "disk")
+    assert code == 2 and "scene.yaml" in err and "blur_sigma" in err
