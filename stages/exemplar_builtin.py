@@ -31,6 +31,7 @@ NAME = "exemplar_builtin"
 VERSION = 1
 
 PAPER_COLOUR = (0.965, 0.945, 0.9)
+WET_DEEPENING = 0.3
 _HEX_COLOUR = re.compile(r"^#[0-9a-fA-F]{6}$")
 
 
@@ -193,8 +194,10 @@ def _watercolor_frames(params, state, wash, *, reference, steps):
     _, _, paper_rgb = _paper(params)
     absorption, scattering = _pigment_coefficients(params.color)
     steps_per_frame = max(1, round(steps / params.frames))
-    for pigment, _, flow in watercolor.simulate_wash(state, wash, frames=params.frames, steps_per_frame=steps_per_frame):
-        linear = watercolor.km_render(pigment / reference, absorption, scattering, paper_rgb)
+    for pigment, wet, flow in watercolor.simulate_wash(state, wash, frames=params.frames, steps_per_frame=steps_per_frame):
+        # Wet paint looks deeper than dry paint (watercolor "dries lighter").
+        sheen = 1.0 + WET_DEEPENING * ndimage.gaussian_filter(wet.astype(np.float32), 1.0)
+        linear = watercolor.km_render(pigment * sheen / reference, absorption, scattering, paper_rgb)
         yield watercolor.linear_to_srgb(linear), _paint_mask(pigment, reference), flow
 
 
@@ -243,10 +246,10 @@ def _dry_frames(params: Params):
         water=(water * wash_area).astype(np.float32),
     )
     wash = watercolor.WashParams(
-        edge_darkening=0.04, density=0.03, granulation=0.8, slope=0.3, evaporation=1.0 / (1.4 * steps),
-        edge_evaporation=1.0, edge_kernel=max(3, round(10 * scale)),
+        edge_darkening=0.06, density=0.03, granulation=0.8, slope=0.3, evaporation=1.0 / (1.7 * steps),
+        edge_evaporation=1.0, edge_kernel=max(3, round(14 * scale)),
     )
-    return _watercolor_frames(params, state, wash, reference=pigment, steps=steps)
+    return _watercolor_frames(params, state, wash, reference=1.5 * pigment, steps=steps)
 
 
 def _backrun_frames(params: Params):

@@ -1,9 +1,11 @@
-"""``fluidymation exemplar list|make``: the built-in moving exemplars.
+"""``fluidymation exemplar list|make|show``: the built-in moving exemplars.
 
 ``list`` prints each preset's name, description and default parameters (from
 ``configs/exemplars.yaml``); ``make NAME -o DIR`` writes ``DIR/rgb/00000.png …``,
 ``DIR/mask/00000.png …`` (0/255), ``DIR/flow/00000.npy …`` ((H, W, 2) float32, px/frame,
 (dx, dy), y down) and ``DIR/exemplar.json``. Generated exemplars are cached (``--cache``).
+``show DIR -o SHEET.png`` draws a contact sheet of such a folder: frames, frames with the
+mask outline, and the flow (hue = direction, brightness = speed).
 """
 
 from __future__ import annotations
@@ -17,11 +19,12 @@ from pathlib import Path
 
 import numpy as np
 import yaml
+from scipy import ndimage
 
 from fluidymation.errors import InputError
 from fluidymation.pipeline.progress import progress
 from fluidymation.stages import exemplar_builtin
-from fluidymation.stages.files import write_npy, write_png, write_text
+from fluidymation.stages.files import read_image, write_npy, write_png, write_text
 
 _SIZE = re.compile(r"^(\d+)[xX](\d+)$")
 
@@ -45,6 +48,13 @@ def add_parser(subparsers) -> None:
     make.add_argument("--cache", metavar="DIR", help="cache folder (default: $XDG_CACHE_HOME/fluidymation/exemplars)")
     make.add_argument("--no-cache", action="store_true", help="generate without reading or writing the cache")
     make.set_defaults(run=run_make)
+    show = actions.add_parser("show", help="contact sheet of an exemplar folder: frames, mask outlines, flow",
+                              description="Rows: frames; frames with the mask outline in red; flow colour-coded "
+                                          "(hue = direction, brightness = speed relative to the fastest).")
+    show.add_argument("folder", metavar="DIR", help="folder written by `exemplar make` (rgb/, mask/, flow/)")
+    show.add_argument("-o", "--output", metavar="SHEET.png", required=True, help="the contact sheet to write")
+    show.add_argument("--count", type=int, default=6, metavar="N", help="frames shown, evenly spaced (default 6)")
+    show.set_defaults(run=run_show)
 
 
 def preset_defaults() -> dict:
@@ -130,3 +140,57 @@ def run_make(args) -> int:
     if not args.quiet:
         print(f"wrote {params.frames} frames of {params.preset} ({width}x{height}) to {out_dir}")
     return 0
+
+
+def run_show(args) -> int:
+    folder = Path(args.folder)
+    frames = sorted((folder / "rgb").glob("*.png"))
+    if not frames:
+        raise InputError(f"{folder / 'rgb'}: no frames (expected 00000.png ... written by `fluidymation exemplar make`)")
+    if args.count < 1:
+        raise InputError(f"--count must be at least 1, got {args.count}")
+    picks = sorted(set(np.linspace(0, len(frames) - 1, min(args.count, len(frames))).round().astype(int)))
+    columns = []
+    flows = {}
+    for index in picks:
+        flow_path = folder / "flow" / f"{frames[index].stem}.npy"
+        if flow_path.is_file():
+            flows[index] = np.load(flow_path)
+    fastest = max([float(np.hypot(f[..., 0], f[..., 1]).max()) for f in flows.values()] + [1e-6])
+    for index in picks:
+        rgb = read_image(frames[index], channels=3)
+        outlined = rgb.copy()
+        mask_path = folder / "mask" / frames[index].name
+        if mask_path.is_file():
+            mask = read_image(mask_path, channels=1)[:, :, 0] > 0.5
+            outlined[mask & ~ndimage.binary_erosion(mask)] = (1.0, 0.0, 0.0)
+        flow = flows.get(index)
+        view = _flow_colours(flow, fastest) if flow is not None else np.zeros_like(rgb)
+        if view.shape != rgb.shape:
+            raise InputError(f"{flow_path}: flow of shape {flow.shape} does not match the frame {rgb.shape[:2]}")
+        columns.append(np.concatenate([rgb, outlined, view], axis=0))
+    gap = np.ones((columns[0].shape[0], 4, 3), dtype=np.float32)
+    sheet = np.concatenate([part for column in columns for part in (column, gap)][:-1], axis=1)
+    write_png(args.output, sheet)
+    if not args.quiet:
+        print(f"wrote a contact sheet of {len(picks)} frames to {args.output}")
+    return 0
+
+
+def _flow_colours(flow, fastest):
+    """(H, W, 2) flow to (H, W, 3) RGB: hue from the direction, value from the speed."""
+    hue = (np.arctan2(flow[..., 1], flow[..., 0]) / (2 * np.pi)) % 1.0
+    value = np.clip(np.hypot(flow[..., 0], flow[..., 1]) / fastest, 0.0, 1.0)
+    sector = np.floor(hue * 6.0)
+    fraction = hue * 6.0 - sector
+    falling, rising = value * (1.0 - fraction), value * fraction
+    zero = np.zeros_like(value)
+    choices = [
+        (value, rising, zero), (falling, value, zero), (zero, value, rising),
+        (zero, falling, value), (rising, zero, value), (value, zero, falling),
+    ]
+    sector = sector.astype(int) % 6
+    rgb = np.zeros(flow.shape[:2] + (3,), dtype=np.float32)
+    for k, channels in enumerate(choices):
+        rgb[sector == k] = np.stack(channels, axis=-1)[sector == k]
+    return rgb
