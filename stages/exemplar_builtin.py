@@ -18,6 +18,7 @@ import os
 import re
 import shutil
 import tempfile
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -155,7 +156,7 @@ def _load_entry(entry: Path, params: Params) -> Exemplar:
 @dataclass(frozen=True)
 class _Preset:
     description: str
-    frames: object  # callable(Params) -> iterator of (rgb, mask, flow)
+    frames: Callable[[Params], Iterator[tuple[np.ndarray, np.ndarray, np.ndarray]]]
 
 
 def _scale(params: Params) -> float:
@@ -189,9 +190,8 @@ def _paint_mask(pigment, reference):
     return ndimage.binary_fill_holes(pigment > 0.06 * reference)
 
 
-def _watercolor_frames(params, state, wash, *, reference, steps):
+def _watercolor_frames(params, state, wash, *, paper_rgb, reference, steps):
     """Run a wash and render each frame with Kubelka–Munk over the paper."""
-    _, _, paper_rgb = _paper(params)
     absorption, scattering = _pigment_coefficients(params.color)
     steps_per_frame = max(1, round(steps / params.frames))
     for pigment, wet, flow in watercolor.simulate_wash(state, wash, frames=params.frames, steps_per_frame=steps_per_frame):
@@ -205,7 +205,7 @@ def _bloom_frames(params: Params):
     scale = _scale(params)
     width, height = params.size
     rng = np.random.default_rng([params.seed, 1])
-    paper_height, capacity, _ = _paper(params)
+    paper_height, capacity, paper_rgb = _paper(params)
     centre = (height / 2 + rng.uniform(-0.05, 0.05) * height, width / 2 + rng.uniform(-0.05, 0.05) * width)
     wet = _noisy_disk((height, width), (height / 2, width / 2), 0.47 * min(width, height), rng, softness=1.0) > 0.5
     drop = _noisy_disk((height, width), centre, 0.1 * min(width, height), rng, roughness=0.25, softness=2.0 * scale)
@@ -219,14 +219,14 @@ def _bloom_frames(params: Params):
         saturation=wet * np.float32(0.3),
     )
     wash = watercolor.WashParams(drag=0.5, slope=2.0, edge_darkening=0.01, density=0.008, granulation=0.8)
-    return _watercolor_frames(params, state, wash, reference=0.7 * pigment, steps=round(700 * scale))
+    return _watercolor_frames(params, state, wash, paper_rgb=paper_rgb, reference=0.7 * pigment, steps=round(700 * scale))
 
 
 def _dry_frames(params: Params):
     scale = _scale(params)
     width, height = params.size
     rng = np.random.default_rng([params.seed, 2])
-    paper_height, capacity, _ = _paper(params)
+    paper_height, capacity, paper_rgb = _paper(params)
     centre = (height / 2 + rng.uniform(-0.04, 0.04) * height, width / 2 + rng.uniform(-0.04, 0.04) * width)
     wash_area = _noisy_disk((height, width), centre, 0.33 * min(width, height), rng, roughness=0.2) > 0.5
     pigment = 0.4
@@ -249,14 +249,14 @@ def _dry_frames(params: Params):
         edge_darkening=0.06, density=0.03, granulation=0.8, slope=0.3, evaporation=1.0 / (1.7 * steps),
         edge_evaporation=1.0, edge_kernel=max(3, round(14 * scale)),
     )
-    return _watercolor_frames(params, state, wash, reference=1.5 * pigment, steps=steps)
+    return _watercolor_frames(params, state, wash, paper_rgb=paper_rgb, reference=1.5 * pigment, steps=steps)
 
 
 def _backrun_frames(params: Params):
     scale = _scale(params)
     width, height = params.size
     rng = np.random.default_rng([params.seed, 3])
-    paper_height, capacity, _ = _paper(params)
+    paper_height, capacity, paper_rgb = _paper(params)
     short = min(width, height)
     wash_area = _noisy_disk((height, width), (height / 2, width / 2), 0.42 * short, rng, roughness=0.15) > 0.5
     angle = rng.uniform(0, 2 * np.pi)
@@ -278,7 +278,7 @@ def _backrun_frames(params: Params):
         edge_darkening=0.05, density=0.02, staining=1.5, granulation=0.6, slope=0.5, drag=0.1,
         edge_kernel=max(3, round(10 * scale)),
     )
-    return _watercolor_frames(params, state, wash, reference=1.6 * pigment, steps=steps)
+    return _watercolor_frames(params, state, wash, paper_rgb=paper_rgb, reference=1.6 * pigment, steps=steps)
 
 
 def _crumble_frames(params: Params):

@@ -52,3 +52,20 @@ def test_bad_options_exit_2_with_a_message(cli, tmp_path, option, message):
     code, _, err = cli("exemplar", "make", "crumble", "-o", tmp_path / "x", "--no-cache", *option)
     assert code == 2
     assert message in err
+
+
+def test_show_draws_a_contact_sheet(cli, tmp_path):
+    out_dir = tmp_path / "crumble"
+    assert cli("-q", "exemplar", "make", "crumble", "-o", out_dir, "--size", "32x24", "--frames", 5, "--no-cache")[0] == 0
+    code, _, err = cli("-q", "exemplar", "show", out_dir, "-o", tmp_path / "sheet.png", "--count", 3)
+    assert code == 0, err
+    sheet = iio.imread(tmp_path / "sheet.png")
+    assert sheet.shape == (3 * 24, 3 * 32 + 2 * 4, 3)
+    outline = (sheet[24:48, :, 0] == 255) & (sheet[24:48, :, 1] == 0)
+    assert outline.any()  # the mask outline is drawn in red in the second row
+    assert sheet[48:, :32].any()  # the first frame's flow is not all zero
+
+
+def test_show_without_frames_is_an_input_error(cli, tmp_path):
+    code, _, err = cli("exemplar", "show", tmp_path, "-o", tmp_path / "sheet.png")
+    assert code == 2 and "no frames" in err
