@@ -218,7 +218,7 @@ def _bloom_frames(params: Params):
         suspended=drop * pigment,
         saturation=wet * np.float32(0.3),
     )
-    wash = watercolor.WashParams(drag=0.5, slope=2.0, edge_darkening=0.01, density=0.008, granulation=0.8)
+    wash = watercolor.WashParams(drag=0.5, slope=1.0, edge_darkening=0.01, density=0.008, granulation=0.8)
     return _watercolor_frames(params, state, wash, paper_rgb=paper_rgb, reference=0.7 * pigment, steps=round(700 * scale))
 
 

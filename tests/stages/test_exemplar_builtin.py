@@ -63,8 +63,12 @@ def test_interrupted_cache_write_leaves_no_entry(tmp_path, monkeypatch):
     assert list(tmp_path.iterdir()) == []
 
 
-def test_bloom_grows_with_outward_velocity_at_its_edge():
-    exemplar = eb.make_builtin_exemplar(_params("watercolor-bloom", size=(64, 64), frames=10))
+@pytest.mark.parametrize(
+    "size, frames",
+    [((64, 64), 10), pytest.param((256, 256), 40, marks=pytest.mark.slow)],  # the slow case is the default size
+)
+def test_bloom_grows_with_outward_velocity_at_its_edge(size, frames):
+    exemplar = eb.make_builtin_exemplar(_params("watercolor-bloom", size=size, frames=frames))
     areas = exemplar.mask.sum(axis=(1, 2))
     assert np.all(np.diff(areas) >= 0) and areas[-1] > areas[0]
     outward = total = 0
