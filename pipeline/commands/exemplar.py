@@ -76,14 +76,27 @@ def resolve_params(name: str, *, seed=None, size=None, frames=None, color=None, 
     for key, value in (("seed", seed), ("size", size), ("frames", frames), ("color", color), ("wetness", wetness)):
         if value is not None:
             chosen[key] = value
-    return exemplar_builtin.Params(
-        preset=name,
-        seed=int(chosen["seed"]),
-        size=(int(chosen["size"][0]), int(chosen["size"][1])),
-        frames=int(chosen["frames"]),
-        color=str(chosen["color"]).lower(),
-        wetness=float(chosen["wetness"]),
-    )
+    if isinstance(chosen["size"], str):
+        chosen["size"] = parse_size([chosen["size"]])
+    try:
+        width, height = chosen["size"]
+        return exemplar_builtin.Params(
+            preset=name,
+            seed=_whole(chosen["seed"], "seed"),
+            size=(_whole(width, "size"), _whole(height, "size")),
+            frames=_whole(chosen["frames"], "frames"),
+            color=str(chosen["color"]).lower(),
+            wetness=float(chosen["wetness"]),
+        )
+    except (TypeError, ValueError):
+        raise InputError(f"built-in exemplar {name!r}: expected seed and frames as whole numbers, size as "
+                         f"[width, height], wetness as a number; got {chosen}") from None
+
+
+def _whole(value, key):
+    if isinstance(value, bool) or int(value) != value:
+        raise ValueError(f"{key} must be a whole number")
+    return int(value)
 
 
 def parse_size(tokens) -> tuple[int, int] | None:

@@ -69,3 +69,15 @@ def test_show_draws_a_contact_sheet(cli, tmp_path):
 def test_show_without_frames_is_an_input_error(cli, tmp_path):
     code, _, err = cli("exemplar", "show", tmp_path, "-o", tmp_path / "sheet.png")
     assert code == 2 and "no frames" in err
+
+
+def test_resolve_params_takes_defaults_and_checks_types():
+    from fluidymation.errors import InputError
+    from fluidymation.pipeline.commands.exemplar import resolve_params
+
+    params = resolve_params("crumble", size="64x32", seed=7)
+    assert params.size == (64, 32) and params.seed == 7 and params.frames == 60 and params.color == "#2b2b2b"
+    with pytest.raises(InputError, match="whole numbers"):
+        resolve_params("crumble", seed=1.5)
+    with pytest.raises(InputError, match="valid names"):
+        resolve_params("sand")
