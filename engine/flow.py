@@ -20,7 +20,7 @@ import math
 import numpy as np
 from numba import prange
 
-from fluidymation.engine._jit import parallel_kernel
+from fluidymation.engine._jit import kernel, parallel_kernel
 
 _OUTSIDE = 0
 _FIXED = 1
@@ -72,39 +72,48 @@ def _boundary_velocity(dist_prev, dist_cur, mask, flow, state):
             flow[y, x, 1] = speed * grad_y
 
 
-@parallel_kernel
-def _restrict(state, values, coarse_state, coarse_values):
+@kernel
+def _restrict_state(state, coarse_state):
+    """A coarse cell is fixed if any of its 2x2 fine cells is, else unknown if any is."""
     height, width = state.shape
     coarse_height, coarse_width = coarse_state.shape
-    for cy in prange(coarse_height):
+    for cy in range(coarse_height):
         for cx in range(coarse_width):
+            fixed = False
+            unknown = False
+            for y in range(2 * cy, min(2 * cy + 2, height)):
+                for x in range(2 * cx, min(2 * cx + 2, width)):
+                    fixed = fixed or state[y, x] == _FIXED
+                    unknown = unknown or state[y, x] == _UNKNOWN
+            coarse_state[cy, cx] = _FIXED if fixed else _UNKNOWN if unknown else _OUTSIDE
+
+
+@kernel
+def _restrict_values(state, values, coarse_state, coarse_values):
+    """Fixed coarse cells get the mean of their fixed fine cells, the others zero."""
+    height, width = state.shape
+    coarse_height, coarse_width = coarse_state.shape
+    for cy in range(coarse_height):
+        for cx in range(coarse_width):
+            coarse_values[cy, cx] = 0.0
+            if coarse_state[cy, cx] != _FIXED:
+                continue
             fixed_count = 0
-            unknown_count = 0
-            sum_x = np.float32(0.0)
-            sum_y = np.float32(0.0)
+            total = np.float32(0.0)
             for y in range(2 * cy, min(2 * cy + 2, height)):
                 for x in range(2 * cx, min(2 * cx + 2, width)):
                     if state[y, x] == _FIXED:
                         fixed_count += 1
-                        sum_x += values[y, x, 0]
-                        sum_y += values[y, x, 1]
-                    elif state[y, x] == _UNKNOWN:
-                        unknown_count += 1
-            if fixed_count > 0:
-                coarse_state[cy, cx] = _FIXED
-                coarse_values[cy, cx, 0] = sum_x / fixed_count
-                coarse_values[cy, cx, 1] = sum_y / fixed_count
-            else:
-                coarse_state[cy, cx] = _UNKNOWN if unknown_count > 0 else _OUTSIDE
-                coarse_values[cy, cx, 0] = 0.0
-                coarse_values[cy, cx, 1] = 0.0
+                        total += values[y, x]
+            coarse_values[cy, cx] = total / fixed_count
 
 
-@parallel_kernel
+@kernel
 def _prolong(coarse_state, coarse_values, state, values):
+    """Bilinear interpolation onto the unknown fine cells, ignoring outside coarse cells."""
     height, width = state.shape
     coarse_height, coarse_width = coarse_state.shape
-    for y in prange(height):
+    for y in range(height):
         # pixel centre in coarse pixel coordinates
         cy_f = 0.5 * y - 0.25
         cy0 = min(max(int(math.floor(cy_f)), 0), coarse_height - 1)
@@ -118,76 +127,162 @@ def _prolong(coarse_state, coarse_values, state, values):
             cx1 = min(cx0 + 1, coarse_width - 1)
             wx1 = min(max(cx_f - cx0, 0.0), 1.0)
             total_weight = 0.0
-            sum_x = 0.0
-            sum_y = 0.0
+            total = 0.0
             for corner in range(4):
                 cy = cy1 if corner >= 2 else cy0
                 cx = cx1 if corner % 2 == 1 else cx0
                 weight = (wy1 if corner >= 2 else 1.0 - wy1) * (wx1 if corner % 2 == 1 else 1.0 - wx1)
                 if coarse_state[cy, cx] != _OUTSIDE and weight > 0.0:
                     total_weight += weight
-                    sum_x += weight * coarse_values[cy, cx, 0]
-                    sum_y += weight * coarse_values[cy, cx, 1]
-            if total_weight > 0.0:
-                values[y, x, 0] = sum_x / total_weight
-                values[y, x, 1] = sum_y / total_weight
-            else:
-                values[y, x, 0] = coarse_values[y // 2, x // 2, 0]
-                values[y, x, 1] = coarse_values[y // 2, x // 2, 1]
+                    total += weight * coarse_values[cy, cx]
+            values[y, x] = total / total_weight if total_weight > 0.0 else coarse_values[y // 2, x // 2]
 
 
-@parallel_kernel
-def _relax(state, values, sweeps, omega):
-    """Red-black Gauss-Seidel with over-relaxation; each colour pass writes only its
-    own cells and reads only the other colour, so rows can run in parallel."""
+@kernel
+def _near_fixed(state, reach, near):
+    """``near[y, x]``: a fixed cell lies within Chebyshev distance ``reach``."""
+    height, width = state.shape
+    for y in range(height):
+        since = reach + 1
+        for x in range(width):
+            since = 0 if state[y, x] == _FIXED else since + 1
+            near[y, x] = since <= reach
+        since = reach + 1
+        for x in range(width - 1, -1, -1):
+            since = 0 if state[y, x] == _FIXED else since + 1
+            near[y, x] = near[y, x] or since <= reach
+    # ``since`` per column, but rows scanned in order so the inner loop is contiguous
+    along_rows = near.copy()
+    since_row = np.full(width, reach + 1, dtype=np.int32)
+    for y in range(height):
+        for x in range(width):
+            since_row[x] = 0 if along_rows[y, x] else since_row[x] + 1
+            near[y, x] = since_row[x] <= reach
+    since_row[:] = reach + 1
+    for y in range(height - 1, -1, -1):
+        for x in range(width):
+            since_row[x] = 0 if along_rows[y, x] else since_row[x] + 1
+            near[y, x] = near[y, x] or since_row[x] <= reach
+
+
+@kernel
+def _list_runs(near, counts, starts, stops):
+    """Runs of ``near`` cells per row: ``counts[y]`` of them, appended to starts/stops;
+    returns how many were written."""
+    height, width = near.shape
+    run = 0
+    for y in range(height):
+        first = run
+        for x in range(width):
+            if near[y, x] and (x == 0 or not near[y, x - 1]):
+                starts[run] = x
+            if near[y, x] and (x == width - 1 or not near[y, x + 1]):
+                stops[run] = x + 1
+                run += 1
+        counts[y] = run - first
+    return run
+
+
+@kernel
+def _relax(state, values, row_runs, starts, stops, sweeps, omega):
+    """Red-black Gauss-Seidel with over-relaxation on the unknown cells of the row runs
+    (row ``y`` owns runs ``row_runs[y]:row_runs[y + 1]``, each ``[start, stop)``)."""
     height, width = state.shape
     for _ in range(sweeps):
         for colour in range(2):
-            for y in prange(height):
-                for x in range((y + colour) % 2, width, 2):
-                    if state[y, x] != _UNKNOWN:
-                        continue
-                    count = 0
-                    sum_x = np.float32(0.0)
-                    sum_y = np.float32(0.0)
-                    if x > 0 and state[y, x - 1] != _OUTSIDE:
-                        count += 1
-                        sum_x += values[y, x - 1, 0]
-                        sum_y += values[y, x - 1, 1]
-                    if x < width - 1 and state[y, x + 1] != _OUTSIDE:
-                        count += 1
-                        sum_x += values[y, x + 1, 0]
-                        sum_y += values[y, x + 1, 1]
-                    if y > 0 and state[y - 1, x] != _OUTSIDE:
-                        count += 1
-                        sum_x += values[y - 1, x, 0]
-                        sum_y += values[y - 1, x, 1]
-                    if y < height - 1 and state[y + 1, x] != _OUTSIDE:
-                        count += 1
-                        sum_x += values[y + 1, x, 0]
-                        sum_y += values[y + 1, x, 1]
-                    if count == 0:
-                        continue
-                    values[y, x, 0] += omega * (sum_x / count - values[y, x, 0])
-                    values[y, x, 1] += omega * (sum_y / count - values[y, x, 1])
+            for y in range(height):
+                for run in range(row_runs[y], row_runs[y + 1]):
+                    start = starts[run]
+                    for x in range(start + (start + y + colour) % 2, stops[run], 2):
+                        if state[y, x] != _UNKNOWN:
+                            continue
+                        count = 0
+                        total = np.float32(0.0)
+                        if x > 0 and state[y, x - 1] != _OUTSIDE:
+                            count += 1
+                            total += values[y, x - 1]
+                        if x < width - 1 and state[y, x + 1] != _OUTSIDE:
+                            count += 1
+                            total += values[y, x + 1]
+                        if y > 0 and state[y - 1, x] != _OUTSIDE:
+                            count += 1
+                            total += values[y - 1, x]
+                        if y < height - 1 and state[y + 1, x] != _OUTSIDE:
+                            count += 1
+                            total += values[y + 1, x]
+                        if count > 0:
+                            values[y, x] += omega * (total / count - values[y, x])
+
+
+@parallel_kernel
+def _solve_levels(states, shapes, cell_offsets, row_offsets, row_runs, starts, stops, fields, sweeps):
+    """The cascadic solve of every channel of ``fields`` (planar, levels packed finest
+    first), one channel per thread; level ``l`` is ``shapes[l]``, its cells start at
+    ``cell_offsets[l]`` and its rows at ``row_offsets[l]`` of ``row_runs``."""
+    levels = shapes.shape[0]
+    for channel in prange(fields.shape[0]):
+        field = fields[channel]
+        grids = []
+        for level in range(levels):
+            cells = slice(cell_offsets[level], cell_offsets[level + 1])
+            shape = (shapes[level, 0], shapes[level, 1])
+            grids.append((states[cells].reshape(shape), field[cells].reshape(shape)))
+        for level in range(1, levels):
+            _restrict_values(grids[level - 1][0], grids[level - 1][1], grids[level][0], grids[level][1])
+        for level in range(levels - 1, -1, -1):
+            state, values = grids[level]
+            if level < levels - 1:
+                _prolong(grids[level + 1][0], grids[level + 1][1], state, values)
+            runs = row_runs[row_offsets[level]: row_offsets[level] + shapes[level, 0] + 1]
+            level_sweeps = sweeps if level < levels - 1 else _COARSEST_SWEEPS
+            _relax(state, values, runs, starts, stops, level_sweeps, np.float32(_OMEGA))
 
 
 def _fill_interior(values: np.ndarray, state: np.ndarray, *, sweeps: int) -> None:
-    """Solve Laplace's equation in place on the unknown cells of ``state``."""
-    levels = [(state, values)]
-    while max(levels[-1][0].shape) > _COARSEST_SIDE:
-        fine_state, fine_values = levels[-1]
-        coarse_shape = ((fine_state.shape[0] + 1) // 2, (fine_state.shape[1] + 1) // 2)
-        coarse_state = np.empty(coarse_shape, dtype=np.int8)
-        coarse_values = np.empty(coarse_shape + (2,), dtype=np.float32)
-        _restrict(fine_state, fine_values, coarse_state, coarse_values)
-        levels.append((coarse_state, coarse_values))
-    coarse_state, coarse_values = levels[-1]
-    _relax(coarse_state, coarse_values, _COARSEST_SWEEPS, np.float32(_OMEGA))
-    for fine_state, fine_values in reversed(levels[:-1]):
-        _prolong(coarse_state, coarse_values, fine_state, fine_values)
-        _relax(fine_state, fine_values, sweeps, np.float32(_OMEGA))
-        coarse_state, coarse_values = fine_state, fine_values
+    """Solve Laplace's equation in place on the unknown cells of ``state``.
+
+    Cascadic multigrid: a full relaxation on the coarsest grid, then on each finer grid
+    the prolonged solution is relaxed only within reach of the fixed cells (where the
+    prolongation errs); farther away it is already smooth, and ``sweeps`` sweeps would
+    carry a correction only about ``2·sweeps`` cells anyway. The two channels are
+    solved in parallel, each by one thread.
+    """
+    states = [state]
+    while max(states[-1].shape) > _COARSEST_SIDE:
+        fine = states[-1]
+        coarse = np.empty(((fine.shape[0] + 1) // 2, (fine.shape[1] + 1) // 2), dtype=np.int8)
+        _restrict_state(fine, coarse)
+        states.append(coarse)
+    heights = np.array([level.shape[0] for level in states])
+    run_counts = np.zeros(heights.sum() + 1, dtype=np.int64)
+    starts, stops = [], []
+    for level, (level_state, row_offset) in enumerate(zip(states, np.cumsum(heights) - heights)):
+        near = np.empty(level_state.shape, dtype=np.bool_)
+        if level < len(states) - 1:
+            _near_fixed(level_state, 2 * sweeps, near)
+        else:
+            near[...] = True
+        level_starts = np.empty(near.size, dtype=np.int64)
+        level_stops = np.empty(near.size, dtype=np.int64)
+        count = _list_runs(near, run_counts[row_offset + 1: row_offset + 1 + near.shape[0]], level_starts, level_stops)
+        starts.append(level_starts[:count])
+        stops.append(level_stops[:count])
+    sizes = np.array([level.size for level in states])
+    cell_offsets = np.concatenate([[0], np.cumsum(sizes)])
+    fields = np.zeros((2, cell_offsets[-1]), dtype=np.float32)
+    fields[:, : state.size] = values.reshape(-1, 2).T
+    _solve_levels(
+        np.concatenate([level.ravel() for level in states]),
+        np.array([level.shape for level in states], dtype=np.int64),
+        cell_offsets,
+        np.cumsum(heights) - heights,
+        np.cumsum(run_counts),
+        np.concatenate(starts),
+        np.concatenate(stops),
+        fields,
+        sweeps,
+    )
+    values[...] = fields[:, : state.size].T.reshape(values.shape)
 
 
 def flow_from_distances(

@@ -1,7 +1,9 @@
 import sys
 from pathlib import Path
 
+import numba
 import numpy as np
+from scipy import ndimage
 
 from fluidymation.engine import flow
 
@@ -78,3 +80,36 @@ def test_weighted_sum_matches_numpy():
     stack = rng.random((5, 7, 9, 2)).astype(np.float32)
     weights = np.array([0.1, 0.0, 0.5, 0.25, 0.15], dtype=np.float32)
     np.testing.assert_allclose(flow.weighted_sum(stack, weights), np.tensordot(weights, stack, axes=1), rtol=1e-5)
+
+
+def test_near_fixed_matches_a_square_dilation():
+    rng = np.random.default_rng(5)
+    state = np.where(rng.random((37, 53)) < 0.01, flow._FIXED, flow._UNKNOWN).astype(np.int8)
+    near = np.empty(state.shape, dtype=bool)
+    flow._near_fixed(state, 4, near)
+    np.testing.assert_array_equal(near, ndimage.maximum_filter(state == flow._FIXED, size=9, mode="constant"))
+
+
+def test_harmonic_fill_far_from_the_fixed_pixels_matches_a_sparse_direct_solve():
+    # the finest grids relax only near the fixed pixels: check a domain much wider than that reach
+    size = 160
+    yy, xx = np.mgrid[:size, :size].astype(np.float64)
+    fixed = _inner_boundary(np.hypot(xx - 50, yy - 60) < 25) | _inner_boundary(np.abs(xx - 125) + np.abs(yy - 110) < 12)
+    domain = np.ones((size, size), dtype=bool)
+    values = np.stack([np.cos(xx / 9.0), np.sin(yy / 13.0) + xx / 80.0], axis=2).astype(np.float32)
+    expected = naive.naive_harmonic_fill(values.astype(np.float64), fixed, domain)
+    result = flow.harmonic_fill(values, fixed, domain, sweeps=8)
+    assert np.abs(result - expected).max() < 0.035 * np.ptp(values[fixed])  # 2.7 %; relaxing everywhere: 2.6 %
+
+
+def test_harmonic_fill_does_not_depend_on_the_thread_count():
+    yy, xx = np.mgrid[:90, :70].astype(np.float64)
+    domain = np.ones((90, 70), dtype=bool)
+    fixed = _inner_boundary(np.hypot(xx - 30, yy - 40) < 20)
+    values = np.stack([xx / 10.0, np.cos(yy / 7.0)], axis=2).astype(np.float32)
+    results = []
+    for threads in (1, numba.config.NUMBA_NUM_THREADS):
+        numba.set_num_threads(threads)
+        results.append(flow.harmonic_fill(values, fixed, domain))
+    numba.set_num_threads(numba.config.NUMBA_NUM_THREADS)
+    np.testing.assert_array_equal(results[0], results[1])
