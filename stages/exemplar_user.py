@@ -21,6 +21,7 @@ from pathlib import Path
 import numpy as np
 from scipy import ndimage
 
+from fluidymation.engine.motion import estimate_motion
 from fluidymation.errors import InputError, StageError
 from fluidymation.stages.files import read_image
 
@@ -245,3 +246,31 @@ def _resize(image, scale):
         return ndimage.map_coordinates(image, grid, order=1, mode="nearest").astype(np.float32)
     return np.stack([ndimage.map_coordinates(image[:, :, c], grid, order=1, mode="nearest")
                      for c in range(image.shape[2])], axis=-1).astype(np.float32)
+
+
+def motion_flow(rgb: np.ndarray, *, seed: int = 0, progress=None) -> np.ndarray:
+    """Flow of a recording estimated from its frames (``flow: motion``), not its masks.
+
+    For media whose masks do not show how the paint moves (paper's exemplar 04). Grid
+    PatchMatch between consecutive frames (:func:`fluidymation.engine.motion.estimate_motion`);
+    ``flow[k]`` is the motion from frame k−1 to k, and frame 0 takes frame 1's.
+
+    Parameters
+    ----------
+    rgb : (T, H, W, 3) float32
+    progress : callable, optional
+        ``progress(done, total)`` after each frame pair.
+
+    Returns
+    -------
+    (T, H, W, 2) float32, px/frame, y down.
+    """
+    count = rgb.shape[0]
+    flow = np.zeros(rgb.shape[:3] + (2,), np.float32)
+    for k in range(1, count):
+        flow[k] = estimate_motion(rgb[k - 1], rgb[k], seed=seed, frame=k)
+        if progress is not None:
+            progress(k, count - 1)
+    if count > 1:
+        flow[0] = flow[1]
+    return flow

@@ -120,3 +120,17 @@ def test_missing_source_and_bad_parameters(tmp_path):
         eu.Params(source="x", step=0)
     with pytest.raises(StageError, match="scale"):
         eu.Params(source="x", scale=0)
+
+
+def test_motion_flow_follows_a_translated_recording():
+    from scipy.ndimage import gaussian_filter, shift
+
+    from fluidymation.stages.exemplar_user import motion_flow
+
+    rng = np.random.default_rng(4)
+    base = gaussian_filter(rng.random((48, 64, 3)), sigma=(1.5, 1.5, 0)).astype(np.float32)
+    rgb = np.stack([shift(base, (0, 2 * k, 0), order=3, mode="reflect") for k in range(3)]).astype(np.float32)
+    flow = motion_flow(rgb, seed=1)
+    assert flow.shape == (3, 48, 64, 2)
+    assert np.abs(flow[1:, 10:-10, 10:-10, 0] - 2).max() < 0.5 and np.abs(flow[1:, 10:-10, 10:-10, 1]).max() < 0.5
+    assert np.array_equal(flow[0], flow[1])
