@@ -49,12 +49,17 @@ def _blur_rows(image, taps, out):
     height, width = image.shape
     radius = taps.shape[0] // 2
     for y in prange(height):
+        # the row extended by its end pixels, so the tap loop runs over contiguous memory
+        padded = np.empty(width + 2 * radius, dtype=np.float32)
+        padded[:radius] = image[y, 0]
+        padded[radius: radius + width] = image[y]
+        padded[radius + width:] = image[y, width - 1]
         for x in range(width):
-            total = np.float32(0.0)
-            for k in range(-radius, radius + 1):
-                xs = min(max(x + k, 0), width - 1)
-                total += taps[k + radius] * image[y, xs]
-            out[y, x] = total
+            out[y, x] = 0.0
+        for k in range(2 * radius + 1):
+            weight = taps[k]
+            for x in range(width):
+                out[y, x] += weight * padded[x + k]
 
 
 @parallel_kernel

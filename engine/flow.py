@@ -31,6 +31,8 @@ _COARSEST_SIDE = 12
 _COARSEST_SWEEPS = 200
 #: Over-relaxation factor of the red-black Gauss-Seidel sweeps.
 _OMEGA = 1.6
+#: Side of the square tiles in which the finer grids are marked for relaxation.
+_TILE = 8
 #: Distance changes at or below this (px) are float rounding of the temporal filter.
 _STILL = 1e-4
 
@@ -139,45 +141,32 @@ def _prolong(coarse_state, coarse_values, state, values):
 
 
 @kernel
-def _near_fixed(state, reach, near):
-    """``near[y, x]``: a fixed cell lies within Chebyshev distance ``reach``."""
+def _runs_near_fixed(state, reach, counts, starts, stops):
+    """Row runs that cover every cell within Chebyshev distance ``reach`` of a fixed
+    cell, in whole tiles of ``_TILE`` x ``_TILE`` cells: row ``y`` gets ``counts[y]``
+    runs ``[start, stop)``, appended to ``starts``/``stops``. Returns the number of runs."""
     height, width = state.shape
-    for y in range(height):
-        since = reach + 1
-        for x in range(width):
-            since = 0 if state[y, x] == _FIXED else since + 1
-            near[y, x] = since <= reach
-        since = reach + 1
-        for x in range(width - 1, -1, -1):
-            since = 0 if state[y, x] == _FIXED else since + 1
-            near[y, x] = near[y, x] or since <= reach
-    # ``since`` per column, but rows scanned in order so the inner loop is contiguous
-    along_rows = near.copy()
-    since_row = np.full(width, reach + 1, dtype=np.int32)
+    tiles_y = (height + _TILE - 1) // _TILE
+    tiles_x = (width + _TILE - 1) // _TILE
+    has_fixed = np.zeros((tiles_y, tiles_x), dtype=np.bool_)
     for y in range(height):
         for x in range(width):
-            since_row[x] = 0 if along_rows[y, x] else since_row[x] + 1
-            near[y, x] = since_row[x] <= reach
-    since_row[:] = reach + 1
-    for y in range(height - 1, -1, -1):
-        for x in range(width):
-            since_row[x] = 0 if along_rows[y, x] else since_row[x] + 1
-            near[y, x] = near[y, x] or since_row[x] <= reach
-
-
-@kernel
-def _list_runs(near, counts, starts, stops):
-    """Runs of ``near`` cells per row: ``counts[y]`` of them, appended to starts/stops;
-    returns how many were written."""
-    height, width = near.shape
+            if state[y, x] == _FIXED:
+                has_fixed[y // _TILE, x // _TILE] = True
+    tile_reach = (reach + _TILE - 1) // _TILE
+    near = np.zeros((tiles_y, tiles_x), dtype=np.bool_)
+    for ty in range(tiles_y):
+        for tx in range(tiles_x):
+            if has_fixed[ty, tx]:
+                near[max(ty - tile_reach, 0): ty + tile_reach + 1, max(tx - tile_reach, 0): tx + tile_reach + 1] = True
     run = 0
     for y in range(height):
         first = run
-        for x in range(width):
-            if near[y, x] and (x == 0 or not near[y, x - 1]):
-                starts[run] = x
-            if near[y, x] and (x == width - 1 or not near[y, x + 1]):
-                stops[run] = x + 1
+        for tx in range(tiles_x):
+            if near[y // _TILE, tx] and (tx == 0 or not near[y // _TILE, tx - 1]):
+                starts[run] = tx * _TILE
+            if near[y // _TILE, tx] and (tx == tiles_x - 1 or not near[y // _TILE, tx + 1]):
+                stops[run] = min((tx + 1) * _TILE, width)
                 run += 1
         counts[y] = run - first
     return run
@@ -215,12 +204,18 @@ def _relax(state, values, row_runs, starts, stops, sweeps, omega):
 
 
 @parallel_kernel
-def _solve_levels(states, shapes, cell_offsets, row_offsets, row_runs, starts, stops, fields, sweeps):
-    """The cascadic solve of every channel of ``fields`` (planar, levels packed finest
-    first), one channel per thread; level ``l`` is ``shapes[l]``, its cells start at
+def _solve_levels(states, shapes, cell_offsets, row_offsets, row_runs, starts, stops, values, fields, sweeps):
+    """The cascadic solve of both channels of ``values`` (H, W, 2), one channel per
+    thread, on the planar work space ``fields`` (2, cells). The levels are packed
+    finest first: level ``l`` has shape ``shapes[l]``, its cells start at
     ``cell_offsets[l]`` and its rows at ``row_offsets[l]`` of ``row_runs``."""
+    height, width = values.shape[:2]
+    for y in prange(height):
+        for x in range(width):
+            fields[0, y * width + x] = values[y, x, 0]
+            fields[1, y * width + x] = values[y, x, 1]
     levels = shapes.shape[0]
-    for channel in prange(fields.shape[0]):
+    for channel in prange(2):
         field = fields[channel]
         grids = []
         for level in range(levels):
@@ -230,22 +225,26 @@ def _solve_levels(states, shapes, cell_offsets, row_offsets, row_runs, starts, s
         for level in range(1, levels):
             _restrict_values(grids[level - 1][0], grids[level - 1][1], grids[level][0], grids[level][1])
         for level in range(levels - 1, -1, -1):
-            state, values = grids[level]
+            state, level_values = grids[level]
             if level < levels - 1:
-                _prolong(grids[level + 1][0], grids[level + 1][1], state, values)
+                _prolong(grids[level + 1][0], grids[level + 1][1], state, level_values)
             runs = row_runs[row_offsets[level]: row_offsets[level] + shapes[level, 0] + 1]
             level_sweeps = sweeps if level < levels - 1 else _COARSEST_SWEEPS
-            _relax(state, values, runs, starts, stops, level_sweeps, np.float32(_OMEGA))
+            _relax(state, level_values, runs, starts, stops, level_sweeps, np.float32(_OMEGA))
+    for y in prange(height):
+        for x in range(width):
+            values[y, x, 0] = fields[0, y * width + x]
+            values[y, x, 1] = fields[1, y * width + x]
 
 
 def _fill_interior(values: np.ndarray, state: np.ndarray, *, sweeps: int) -> None:
     """Solve Laplace's equation in place on the unknown cells of ``state``.
 
     Cascadic multigrid: a full relaxation on the coarsest grid, then on each finer grid
-    the prolonged solution is relaxed only within reach of the fixed cells (where the
-    prolongation errs); farther away it is already smooth, and ``sweeps`` sweeps would
-    carry a correction only about ``2·sweeps`` cells anyway. The two channels are
-    solved in parallel, each by one thread.
+    the prolonged solution is relaxed only near the fixed cells (where the prolongation
+    errs); farther away it is already smooth, and ``sweeps`` sweeps would carry a
+    correction only about ``2·sweeps`` cells anyway. The two channels are solved in
+    parallel, each by one thread.
     """
     states = [state]
     while max(states[-1].shape) > _COARSEST_SIDE:
@@ -254,35 +253,35 @@ def _fill_interior(values: np.ndarray, state: np.ndarray, *, sweeps: int) -> Non
         _restrict_state(fine, coarse)
         states.append(coarse)
     heights = np.array([level.shape[0] for level in states])
+    row_offsets = np.cumsum(heights) - heights
     run_counts = np.zeros(heights.sum() + 1, dtype=np.int64)
     starts, stops = [], []
-    for level, (level_state, row_offset) in enumerate(zip(states, np.cumsum(heights) - heights)):
-        near = np.empty(level_state.shape, dtype=np.bool_)
-        if level < len(states) - 1:
-            _near_fixed(level_state, 2 * sweeps, near)
-        else:
-            near[...] = True
-        level_starts = np.empty(near.size, dtype=np.int64)
-        level_stops = np.empty(near.size, dtype=np.int64)
-        count = _list_runs(near, run_counts[row_offset + 1: row_offset + 1 + near.shape[0]], level_starts, level_stops)
+    for level, level_state in enumerate(states):
+        counts = run_counts[row_offsets[level] + 1: row_offsets[level] + 1 + level_state.shape[0]]
+        if level == len(states) - 1:  # the coarsest grid is relaxed everywhere
+            counts[...] = 1
+            starts.append(np.zeros(level_state.shape[0], dtype=np.int64))
+            stops.append(np.full(level_state.shape[0], level_state.shape[1], dtype=np.int64))
+            continue
+        most = level_state.shape[0] * ((level_state.shape[1] + _TILE - 1) // _TILE // 2 + 1)
+        level_starts = np.empty(most, dtype=np.int64)
+        level_stops = np.empty(most, dtype=np.int64)
+        count = _runs_near_fixed(level_state, 2 * sweeps, counts, level_starts, level_stops)
         starts.append(level_starts[:count])
         stops.append(level_stops[:count])
-    sizes = np.array([level.size for level in states])
-    cell_offsets = np.concatenate([[0], np.cumsum(sizes)])
-    fields = np.zeros((2, cell_offsets[-1]), dtype=np.float32)
-    fields[:, : state.size] = values.reshape(-1, 2).T
+    cell_offsets = np.concatenate([[0], np.cumsum([level.size for level in states])])
     _solve_levels(
         np.concatenate([level.ravel() for level in states]),
         np.array([level.shape for level in states], dtype=np.int64),
         cell_offsets,
-        np.cumsum(heights) - heights,
+        row_offsets,
         np.cumsum(run_counts),
         np.concatenate(starts),
         np.concatenate(stops),
-        fields,
+        values,
+        np.empty((2, cell_offsets[-1]), dtype=np.float32),
         sweeps,
     )
-    values[...] = fields[:, : state.size].T.reshape(values.shape)
 
 
 def flow_from_distances(

@@ -82,12 +82,23 @@ def test_weighted_sum_matches_numpy():
     np.testing.assert_allclose(flow.weighted_sum(stack, weights), np.tensordot(weights, stack, axes=1), rtol=1e-5)
 
 
-def test_near_fixed_matches_a_square_dilation():
+def test_runs_near_fixed_cover_a_square_dilation_in_whole_tiles():
     rng = np.random.default_rng(5)
-    state = np.where(rng.random((37, 53)) < 0.01, flow._FIXED, flow._UNKNOWN).astype(np.int8)
-    near = np.empty(state.shape, dtype=bool)
-    flow._near_fixed(state, 4, near)
-    np.testing.assert_array_equal(near, ndimage.maximum_filter(state == flow._FIXED, size=9, mode="constant"))
+    state = np.where(rng.random((37, 53)) < 0.005, flow._FIXED, flow._UNKNOWN).astype(np.int8)
+    counts = np.empty(37, dtype=np.int64)
+    starts, stops = np.empty((2, 37 * 53), dtype=np.int64)
+    total = flow._runs_near_fixed(state, 4, counts, starts, stops)
+    covered = np.zeros(state.shape, dtype=bool)
+    row_of_run = np.repeat(np.arange(37), counts)
+    for y, start, stop in zip(row_of_run, starts[:total], stops[:total]):
+        covered[y, start:stop] = True
+    fixed = state == flow._FIXED
+    tile = flow._TILE
+    assert (covered | ~ndimage.maximum_filter(fixed, size=9, mode="constant")).all()
+    # reach 4 rounds up to one tile, beyond the fixed cell's own tile
+    assert not (covered & ~ndimage.maximum_filter(fixed, size=2 * (2 * tile - 1) + 1, mode="constant")).any()
+    tiles = covered[: 37 // tile * tile, : 53 // tile * tile].reshape(37 // tile, tile, 53 // tile, tile)
+    assert (tiles.all(axis=(1, 3)) | ~tiles.any(axis=(1, 3))).all()
 
 
 def test_harmonic_fill_far_from_the_fixed_pixels_matches_a_sparse_direct_solve():
