@@ -21,7 +21,8 @@ from fluidymation.engine.nnf import NNF
 
 
 @parallel_kernel
-def _shift(frame_in, coords_in, target_motion, target_angle, source_ext_plus, source_ext_minus, source_angle, frame_out):
+def _shift(frame_in, coords_in, target_motion, target_angle, source_ext_plus, source_ext_minus, source_angle, frame_out,
+           achieved):
     height, width = frame_in.shape
     frames, source_height, source_width = source_ext_plus.shape
     for ty in prange(height):
@@ -29,6 +30,7 @@ def _shift(frame_in, coords_in, target_motion, target_angle, source_ext_plus, so
             frame = frame_in[ty, tx]
             if frame < 0:
                 frame_out[ty, tx] = -1
+                achieved[ty, tx] = 0.0
                 continue
             sx = min(max(int(coords_in[ty, tx, 0] + 0.5), 0), source_width - 1)
             sy = min(max(int(coords_in[ty, tx, 1] + 0.5), 0), source_height - 1)
@@ -37,21 +39,27 @@ def _shift(frame_in, coords_in, target_motion, target_angle, source_ext_plus, so
             wanted = target_motion[ty, tx]
             best_frame = frame
             best_gap = abs(wanted)
+            best_amount = 0.0
             if opposite:
                 start = source_ext_minus[frame, sy, sx]
                 for candidate in range(frame - 1, -1, -1):
-                    gap = abs(wanted - (source_ext_minus[candidate, sy, sx] - start))
+                    amount = source_ext_minus[candidate, sy, sx] - start
+                    gap = abs(wanted - amount)
                     if gap < best_gap:
                         best_gap = gap
                         best_frame = candidate
+                        best_amount = amount
             else:
                 start = source_ext_plus[frame, sy, sx]
                 for candidate in range(frame + 1, frames):
-                    gap = abs(wanted - (source_ext_plus[candidate, sy, sx] - start))
+                    amount = source_ext_plus[candidate, sy, sx] - start
+                    gap = abs(wanted - amount)
                     if gap < best_gap:
                         best_gap = gap
                         best_frame = candidate
+                        best_amount = amount
             frame_out[ty, tx] = best_frame
+            achieved[ty, tx] = best_amount
 
 
 def shift_nnf(nnf, *, target_motion, target_angle, source_ext_plus, source_ext_minus, source_angle):
@@ -75,8 +83,11 @@ def shift_nnf(nnf, *, target_motion, target_angle, source_ext_plus, source_ext_m
 
     Returns
     -------
-    NNF
+    shifted : NNF
         A new field; unmatched pixels (frame -1) stay unmatched.
+    achieved : ndarray, shape (H, W), float32
+        The source motion amount of the chosen shift (0 where unmatched); the caller may
+        carry ``target_motion − achieved`` over to the next frame.
     """
     height, width = nnf.shape
     source_shape = np.shape(source_ext_plus)
@@ -89,12 +100,14 @@ def shift_nnf(nnf, *, target_motion, target_angle, source_ext_plus, source_ext_m
     if len(source_shape) != 3:
         raise ValueError(f"source_ext_plus must have shape (T, Hs, Ws), got {source_shape}")
     frame_out = np.empty((height, width), np.int32)
+    achieved = np.empty((height, width), np.float32)
     _shift(
         nnf.frame, nnf.coords, np.ascontiguousarray(target_motion, np.float32),
         np.ascontiguousarray(target_angle, np.float32), np.ascontiguousarray(source_ext_plus, np.float32),
         np.ascontiguousarray(source_ext_minus, np.float32), np.ascontiguousarray(source_angle, np.float32), frame_out,
+        achieved,
     )
-    return NNF(frame_out, nnf.coords.copy())
+    return NNF(frame_out, nnf.coords.copy()), achieved
 
 
 @parallel_kernel

@@ -17,7 +17,7 @@ import traceback
 from fluidymation import __version__
 from fluidymation.errors import FluidymationError
 
-COMMANDS = ("check", "masks", "guides", "synth", "exemplar")
+COMMANDS = ("check", "masks", "guides", "synth", "exemplar", "render")
 
 EXIT_USAGE = 2
 EXIT_INTERNAL = 1

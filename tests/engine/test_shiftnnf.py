@@ -20,22 +20,23 @@ def _ramp_source(frames=6, size=4, speed=2.0):
 
 def test_forward_shift_matches_the_target_motion_exactly():
     plus, minus, angle = _ramp_source()
-    shifted = shift_nnf(_single(1, 2.0, 1.0, 0.0), target_motion=np.array([[4.0]], np.float32),
+    shifted, achieved = shift_nnf(_single(1, 2.0, 1.0, 0.0), target_motion=np.array([[4.0]], np.float32),
                         target_angle=np.zeros((1, 1), np.float32), source_ext_plus=plus,
                         source_ext_minus=minus, source_angle=angle)
     assert shifted.frame[0, 0] == 3  # moved 2 px per source frame: 4 px is 2 frames on
+    assert achieved[0, 0] == 4.0
     np.testing.assert_array_equal(shifted.coords, [[[2.0, 1.0, 0.0]]])
 
 
 def test_opposite_flow_shifts_backward_with_ext_minus():
     plus, minus, angle = _ramp_source()
     # target flows along −x, the unrotated source along +x: roughly opposite
-    shifted = shift_nnf(_single(4, 1.0, 1.0, 0.0), target_motion=np.array([[6.0]], np.float32),
+    shifted, achieved = shift_nnf(_single(4, 1.0, 1.0, 0.0), target_motion=np.array([[6.0]], np.float32),
                         target_angle=np.full((1, 1), math.pi, np.float32), source_ext_plus=plus,
                         source_ext_minus=minus, source_angle=angle)
-    assert shifted.frame[0, 0] == 1
+    assert shifted.frame[0, 0] == 1 and achieved[0, 0] == 6.0
     # the same match rotated by π follows the target: forward again, clamped at the last frame
-    shifted = shift_nnf(_single(4, 1.0, 1.0, math.pi), target_motion=np.array([[6.0]], np.float32),
+    shifted, achieved = shift_nnf(_single(4, 1.0, 1.0, math.pi), target_motion=np.array([[6.0]], np.float32),
                         target_angle=np.full((1, 1), math.pi, np.float32), source_ext_plus=plus,
                         source_ext_minus=minus, source_angle=angle)
     assert shifted.frame[0, 0] == 5
@@ -44,7 +45,7 @@ def test_opposite_flow_shifts_backward_with_ext_minus():
 def test_no_target_motion_and_unmatched_pixels_stay():
     plus, minus, angle = _ramp_source()
     nnf = NNF(np.array([[2, -1]], np.int32), np.array([[[1, 1, 0], [0, 0, 0]]], np.float32))
-    shifted = shift_nnf(nnf, target_motion=np.zeros((1, 2), np.float32), target_angle=np.zeros((1, 2), np.float32),
+    shifted, achieved = shift_nnf(nnf, target_motion=np.zeros((1, 2), np.float32), target_angle=np.zeros((1, 2), np.float32),
                         source_ext_plus=plus, source_ext_minus=minus, source_angle=angle)
     np.testing.assert_array_equal(shifted.frame, [[2, -1]])
 
@@ -61,7 +62,7 @@ def test_shift_agrees_with_the_naive_search():
                        rng.uniform(-np.pi, np.pi, shape)], axis=2).astype(np.float32)
     motion = rng.uniform(0, 6, shape).astype(np.float32)
     target_angle = rng.uniform(-np.pi, np.pi, shape).astype(np.float32)
-    shifted = shift_nnf(NNF(frame, coords), target_motion=motion, target_angle=target_angle,
+    shifted, achieved = shift_nnf(NNF(frame, coords), target_motion=motion, target_angle=target_angle,
                         source_ext_plus=plus, source_ext_minus=np.ascontiguousarray(minus), source_angle=source_angle)
     expected = naive_shift_frames(frame, coords, motion, target_angle, plus, minus, source_angle)
     np.testing.assert_array_equal(shifted.frame, expected)

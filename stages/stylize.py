@@ -1,0 +1,297 @@
+"""The ``stylize`` stage: Fluidymation synthesis of one layer, frame by frame.
+
+Every target frame is synthesized from patches of the whole moving exemplar
+(paper section 3, appendix B; thesis chapter 3, sections 4.2–4.4; ALGORITHM.md) with the
+patch distance
+
+    |rgb|² + w_bound |shape|² + w_ext (|ext+|² + |ext−|²) + m(q) w_temp |temp|²
+    + w_dir |tan(S_dir + θ − T_dir)| + w_uni λ Ω/ω*
+
+(ext± divided by ``ext_unit``; ext+ and ext− swapped where source and target flows are
+opposite), segment-restricted matching (border/interior), two flow-aligned rotations per
+candidate, and the per-segment 3D uniformity budget. The first synthesized frame starts
+from a random field refined by a guides-only pass; every later frame starts from
+``NNF_prev = SHIFTNNF(NNF_{j−1})``, merged per pyramid level with the upscaled field,
+and its temporal guide is the exemplar voted through ``NNF_prev``, weighted by m(q).
+
+Frames are processed in order (or from the last to the first with ``reverse``); the
+target guides are computed over the whole sequence in processing order and streamed
+from an on-disk cache, so memory does not grow with the number of frames.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+from typing import Callable, Iterator, NamedTuple
+
+import numpy as np
+
+from fluidymation.engine.nnf import NNF
+from fluidymation.engine.random import counter_hash
+from fluidymation.engine.shiftnnf import shift_nnf, temporal_modulation
+from fluidymation.engine.synthesis import SynthesisInputs, SynthesisParams, synthesize
+from fluidymation.engine.vote import vote
+from fluidymation.errors import StageError
+from fluidymation.stages import guides
+
+NAME = "stylize"
+VERSION = 1
+
+#: Target guide channels, in order; the source compares shape, ext+, ext− and its colour (as S_temp).
+_GUIDES = ("shape", "ext_plus", "ext_minus", "temp_r", "temp_g", "temp_b")
+_OPPOSITE = np.array([0, 2, 1, 3, 4, 5], np.int64)
+_WEIGHT_MAP = np.array([-1, -1, -1, 0, 0, 0], np.int64)
+
+
+@dataclass(frozen=True)
+class Params:
+    """Parameters of the stylize stage (paper Table 1, thesis CLI table).
+
+    Attributes
+    ----------
+    patch_size : int
+        n, odd.
+    w_bound, w_ext, w_dir, w_temp, w_uni : float
+        Weights of the shape, motion-extent, orientation, temporal and uniformity terms;
+        any may be 0.
+    uniformity_lambda : float
+        λ: the uniformity penalty at exactly the budget (Ω = ω*) in the units of the
+        colour SSD (sRGB in [0, 1]); the penalty weight is ``w_uni · λ``.
+    cuboid_radius : int
+        r, frames before and after a patch that count as used (uniformity).
+    m_lower, m_upper : float
+        Temporal modulation bounds as fractions of d, the larger target side: m = 1
+        where the (border-clamped) distances differ by ≤ m_lower·d, 0 by ≥ m_upper·d.
+    ext_unit : float
+        Length in px that ext+ and ext− are divided by before comparison.
+    dir_clamp : float
+        Clamp of ``|tan|`` in the orientation term.
+    alpha : float
+        Random-search box shrink factor.
+    opt_iters, pm_iters : tuple of int
+        Search-vote and PatchMatch iterations per level, coarsest first; the last value
+        repeats.
+    vote_only_finest : bool
+        Only vote the finest level from the upscaled field.
+    guided_init : bool
+        Refine the first frame's random field with a guides-only pass.
+    pyramid_levels : int or None
+        None: ``floor(log2(d_min / n))`` capped so the coarsest level fits 2n + 1.
+    reverse : bool
+        Synthesize from the last frame to the first (material being added).
+    seed : int
+    """
+
+    patch_size: int = 5
+    w_bound: float = 4.0
+    w_ext: float = 0.25
+    w_dir: float = 0.0
+    w_temp: float = 4.0
+    w_uni: float = 1.0
+    uniformity_lambda: float = 0.3
+    cuboid_radius: int = 5
+    m_lower: float = 0.01
+    m_upper: float = 0.1
+    ext_unit: float = 10.0
+    dir_clamp: float = 10.0
+    alpha: float = 0.75
+    opt_iters: tuple = (4, 2, 1)
+    pm_iters: tuple = (6, 4, 4)
+    vote_only_finest: bool = True
+    guided_init: bool = True
+    pyramid_levels: int | None = None
+    reverse: bool = False
+    seed: int = 0
+
+    def __post_init__(self):
+        for name in ("opt_iters", "pm_iters"):
+            value = getattr(self, name)
+            if isinstance(value, (int, np.integer)):
+                value = (value,)
+            object.__setattr__(self, name, tuple(int(v) for v in value))
+        checks = (
+            ("patch_size", self.patch_size >= 3 and self.patch_size % 2 == 1, "an odd number ≥ 3"),
+            ("w_bound", self.w_bound >= 0, "≥ 0"), ("w_ext", self.w_ext >= 0, "≥ 0"),
+            ("w_dir", self.w_dir >= 0, "≥ 0"), ("w_temp", self.w_temp >= 0, "≥ 0"),
+            ("w_uni", self.w_uni >= 0, "≥ 0"), ("uniformity_lambda", self.uniformity_lambda >= 0, "≥ 0"),
+            ("cuboid_radius", self.cuboid_radius >= 0, "≥ 0"),
+            ("m_lower", 0 <= self.m_lower <= self.m_upper, "between 0 and m_upper"),
+            ("ext_unit", self.ext_unit > 0, "positive"), ("dir_clamp", self.dir_clamp > 0, "positive"),
+            ("alpha", 0 < self.alpha < 1, "between 0 and 1 (exclusive)"),
+            ("opt_iters", bool(self.opt_iters) and min(self.opt_iters) >= 0, "a list of counts ≥ 0"),
+            ("pm_iters", bool(self.pm_iters) and min(self.pm_iters) >= 0, "a list of counts ≥ 0"),
+            ("pyramid_levels", self.pyramid_levels is None or self.pyramid_levels >= 1, "≥ 1"),
+            ("seed", 0 <= self.seed < 2**31, "between 0 and 2^31 − 1"),
+        )
+        for name, valid, wanted in checks:
+            if not valid:
+                raise StageError(f"stylize: parameter {name} must be {wanted}, got {getattr(self, name)!r}")
+
+
+def parameter_names() -> tuple[str, ...]:
+    """Names of every stylize parameter."""
+    return tuple(field.name for field in dataclasses.fields(Params))
+
+
+@dataclass(frozen=True)
+class Source:
+    """The exemplar with its guidance channels, ``(T, Hs, Ws)`` unless noted.
+
+    ``rgb`` (T, Hs, Ws, 3) float32 in [0, 1]; ``dist`` signed distance clamped at the
+    border width; ``shape``, ``ext_plus``, ``ext_minus``, ``angle`` float32; ``segment``
+    int32 (-1 outside the exemplar's mask, 0 border, 1 interior).
+    """
+
+    rgb: np.ndarray
+    dist: np.ndarray
+    shape: np.ndarray
+    ext_plus: np.ndarray
+    ext_minus: np.ndarray
+    angle: np.ndarray
+    segment: np.ndarray
+
+    @property
+    def frame_count(self) -> int:
+        return self.rgb.shape[0]
+
+
+def prepare_source(rgb: np.ndarray, cache: guides.GuideCache) -> Source:
+    """Gather an exemplar's colour and its guides (from :func:`guides.compute_guides`) into a :class:`Source`."""
+    rgb = np.ascontiguousarray(rgb, np.float32)
+    if rgb.ndim != 4 or rgb.shape[3] != 3 or rgb.shape[:3] != (cache.frame_count, cache.height, cache.width):
+        raise StageError(f"stylize: exemplar colour of shape {rgb.shape} does not match its guides "
+                         f"({cache.frame_count} frames of {cache.width}x{cache.height})")
+    frames = [cache.frame(index) for index in range(cache.frame_count)]
+    return Source(
+        rgb=rgb,
+        dist=np.stack([border_clamped(f.dist, cache.border_width) for f in frames]),
+        shape=np.stack([f.shape for f in frames]),
+        ext_plus=np.stack([f.ext_plus for f in frames]),
+        ext_minus=np.stack([f.ext_minus for f in frames]),
+        angle=np.stack([f.direction for f in frames]),
+        segment=np.stack([f.segments.astype(np.int32) - 1 for f in frames]),
+    )
+
+
+class StylizedFrame(NamedTuple):
+    """One synthesized frame: its index in the sequence, RGBA (H, W, 4) float32, the NNF and its mean error."""
+
+    index: int
+    rgba: np.ndarray
+    nnf: NNF
+    mean_error: float
+
+
+def stylize_sequence(
+    masks: Callable[[int], np.ndarray],
+    frame_count: int,
+    source: Source,
+    *,
+    params: Params,
+    guide_params: guides.Params,
+    cache_dir,
+    frames: tuple[int, int] | None = None,
+) -> Iterator[StylizedFrame]:
+    """Stylize a layer's mask sequence; yield each frame as soon as it is done.
+
+    Parameters
+    ----------
+    masks : callable
+        ``masks(j)`` gives frame j's (H, W) coverage in [0, 1] (float) or bool; it becomes
+        the alpha channel (soft edges) and, through the guides, the target.
+    frame_count : int
+        Frames of the whole sequence (the guides span all of them).
+    source : Source
+    params : Params
+    guide_params : guides.Params
+        Must be the parameters the source's guides were made with.
+    cache_dir : path
+        Folder for the target guides cache.
+    frames : (first, stop), optional
+        Only synthesize sequence frames first..stop−1 (the first one processed starts
+        afresh). Default: all.
+
+    Yields
+    ------
+    StylizedFrame
+        In processing order (descending indices with ``reverse``).
+    """
+    first, stop = (0, frame_count) if frames is None else frames
+    if not 0 <= first < stop <= frame_count:
+        raise StageError(f"stylize: frames {first}:{stop} outside 0:{frame_count}")
+    order = list(range(frame_count - 1, -1, -1)) if params.reverse else list(range(frame_count))
+    target = guides.compute_guides(lambda k: masks(order[k]), frame_count, params=guide_params, cache_dir=cache_dir)
+    steps = [k for k in range(frame_count) if first <= order[k] < stop]
+    d = max(target.height, target.width)
+    synthesis = SynthesisParams(
+        patch_size=params.patch_size, pyramid_levels=params.pyramid_levels, search_vote_iters=params.opt_iters,
+        patchmatch_iters=params.pm_iters, vote_only_finest=params.vote_only_finest,
+        guided_initialization=params.guided_init, alpha=params.alpha,
+        uniformity_weight=params.w_uni * params.uniformity_lambda, uniformity_radius=params.cuboid_radius,
+        orientation_weight=params.w_dir, orientation_clamp=params.dir_clamp, rotation="flow", seed=params.seed,
+    )
+    unit = np.float32(1.0 / params.ext_unit)
+    source_guides = np.concatenate([
+        source.shape[..., None], source.ext_plus[..., None] * unit, source.ext_minus[..., None] * unit, source.rgb,
+    ], axis=3)
+    guide_weights = np.array([params.w_bound, params.w_ext, params.w_ext] + [params.w_temp] * 3, np.float32)
+
+    previous = None  # (NNF, inside mask, ext+, motion not yet followed) of the frame processed before
+    for k in steps:
+        index = order[k]
+        frame = target.frame(k)
+        coverage = _coverage(masks(index), (target.height, target.width), index)
+        inside = frame.mask | (coverage > 0)
+        segment = np.where(inside, np.maximum(frame.segments.astype(np.int32) - 1, 0), -1).astype(np.int32)
+        temp = np.zeros((target.height, target.width, 3), np.float32)
+        modulation = np.zeros((1, target.height, target.width), np.float32)
+        initial = None
+        backlog = np.zeros((target.height, target.width), np.float32)
+        if previous is not None:
+            previous_nnf, previous_inside, previous_ext_plus, previous_backlog = previous
+            # Motion smaller than one source frame's would be lost frame after frame: carry it over.
+            wanted = frame.ext_plus - previous_ext_plus + np.where(previous_inside, previous_backlog, 0.0)
+            initial, achieved = shift_nnf(
+                previous_nnf, target_motion=wanted, target_angle=frame.direction,
+                source_ext_plus=source.ext_plus, source_ext_minus=source.ext_minus, source_angle=source.angle,
+            )
+            backlog = np.where(initial.frame >= 0, wanted - achieved, 0.0).astype(np.float32)
+            if params.w_temp > 0:
+                temp, _ = vote(source.rgb, initial, patch_size=params.patch_size)
+                modulation[0] = temporal_modulation(
+                    initial, target_dist=border_clamped(frame.dist, target.border_width), source_dist=source.dist,
+                    previous_mask=previous_inside, lower=params.m_lower * d, upper=params.m_upper * d,
+                )
+        target_guides = np.concatenate([
+            frame.shape[..., None], frame.ext_plus[..., None] * unit, frame.ext_minus[..., None] * unit, temp,
+        ], axis=2)
+        result = synthesize(
+            SynthesisInputs(
+                source_colour=source.rgb, source_guides=source_guides, target_guides=target_guides,
+                colour_weights=np.ones(3, np.float32), guide_weights=guide_weights, weight_maps=modulation,
+                guide_weight_map=_WEIGHT_MAP, opposite_guide=_OPPOSITE, source_angle=source.angle,
+                target_angle=frame.direction, source_segment=source.segment, target_segment=segment,
+                initial_nnf=initial,
+            ),
+            dataclasses.replace(synthesis, seed=int(counter_hash(params.seed, k) % np.uint64(2**31))),
+        )
+        rgba = np.concatenate([np.clip(result.image, 0.0, 1.0), coverage[..., None]], axis=2)
+        previous = (result.nnf, inside, frame.ext_plus, backlog)
+        yield StylizedFrame(index=index, rgba=rgba, nnf=result.nnf, mean_error=result.mean_error())
+
+
+def _coverage(mask, shape, index) -> np.ndarray:
+    mask = np.asarray(mask)
+    if mask.shape != shape:
+        raise StageError(f"stylize: mask of frame {index} has shape {mask.shape}, expected {shape}")
+    if mask.dtype == np.bool_:
+        return mask.astype(np.float32)
+    if mask.dtype == np.uint8:
+        return mask.astype(np.float32) / np.float32(255.0)
+    return np.clip(mask, 0.0, 1.0).astype(np.float32)
+
+
+def border_clamped(dist: np.ndarray, border_width: float) -> np.ndarray:
+    """Signed distance clamped at the border width (the distance m(q) compares)."""
+    return np.minimum(np.asarray(dist, np.float32), np.float32(border_width))

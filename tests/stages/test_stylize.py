@@ -1,0 +1,151 @@
+"""The stylize stage on tiny sequences: a synthetic spreading stain as the exemplar."""
+
+import dataclasses
+
+import numba
+import numpy as np
+import pytest
+from scipy import ndimage
+
+from fluidymation.errors import StageError
+from fluidymation.stages import guides, stylize
+
+SIZE = 48
+GUIDES = guides.Params(blur_sigma=1.5, shape_radius=6, border_width=3, dist_time_sigma=0.5, flow_time_radius=1)
+# At 48 px the pyramid is 12/24/48 px: a vote-only finest level would blur the texture
+# (measured: contrast falls to ~0.8 of the exemplar's), so these tiny tests optimise it.
+FAST = stylize.Params(vote_only_finest=False)
+
+
+def _stain(frames=16, size=40, seed=1, speed=1.0):
+    """A round wash whose blotchy 2–4 px texture drifts along +x at ``speed`` px/frame.
+
+    Returns rgb (T, H, W, 3), mask (T, H, W) and the exact flow (T, H, W, 2).
+    """
+    rng = np.random.default_rng(seed)
+    texture = ndimage.gaussian_filter(rng.standard_normal((size, 3 * size)), 1.5, mode="wrap")
+    texture = (texture - texture.mean()) / texture.std()
+    yy, xx = np.mgrid[:size, :size].astype(np.float64)
+    centre = (size - 1) / 2
+    inside = np.hypot(yy - centre, xx - centre) < 0.45 * size
+    paper = np.array([0.96, 0.94, 0.9])
+    pigment = np.array([0.2, 0.45, 0.85])
+    rgb = np.empty((frames, size, size, 3), np.float32)
+    flow = np.zeros((frames, size, size, 2), np.float32)
+    for t in range(frames):
+        drifted = ndimage.map_coordinates(texture, [yy, xx - speed * t + size], order=1, mode="grid-wrap")
+        density = np.clip(0.55 + 0.3 * drifted, 0, 1) * inside
+        rgb[t] = paper * (1 - density[..., None]) + pigment * density[..., None]
+        if t > 0:
+            flow[t, ..., 0] = speed * inside
+    return rgb, np.repeat(inside[None], frames, axis=0), flow
+
+
+@pytest.fixture(scope="module")
+def source(tmp_path_factory):
+    rgb, mask, flow = _stain()
+    cache = guides.compute_guides(lambda j: mask[j], len(mask), params=GUIDES,
+                                  cache_dir=tmp_path_factory.mktemp("source"), given_flow=lambda j: flow[j])
+    return stylize.prepare_source(rgb, cache)
+
+
+def _disk(centre_x, radius=13.0, centre_y=SIZE / 2):
+    yy, xx = np.mgrid[:SIZE, :SIZE] + 0.5
+    return np.clip(radius - np.hypot(yy - centre_y, xx - centre_x) + 0.5, 0, 1).astype(np.float32)
+
+
+def _run(masks, count, source, tmp_path, **changes):
+    params = dataclasses.replace(FAST, **changes)
+    return list(stylize.stylize_sequence(masks, count, source, params=params, guide_params=GUIDES,
+                                         cache_dir=tmp_path / f"guides-{len(list(tmp_path.iterdir()))}"))
+
+
+def _local_contrast(rgb, region):
+    lum = rgb[..., :3].mean(axis=2).astype(np.float64)
+    mean = ndimage.uniform_filter(lum, 5)
+    spread = np.sqrt(np.maximum(ndimage.uniform_filter(lum * lum, 5) - mean * mean, 0))
+    return spread[ndimage.binary_erosion(region, iterations=3)].mean()
+
+
+def moving(j):
+    return _disk(18 + 1.0 * j)
+
+
+def test_painted_area_follows_the_target(source, tmp_path):
+    frames = _run(moving, 5, source, tmp_path)
+    assert [f.index for f in frames] == [0, 1, 2, 3, 4]
+    for frame in frames:
+        target = moving(frame.index) > 0.5
+        np.testing.assert_array_equal(frame.rgba[..., 3], moving(frame.index))
+        painted = (frame.rgba[..., 3] > 0.5) & (frame.nnf.frame >= 0)
+        assert (painted & target).sum() / (painted | target).sum() >= 0.95
+
+
+@pytest.mark.xfail(reason="open (issue 6): contrast is 0.76-0.80 of the exemplar's on this 48 px scene and the "
+                          "texture of a translating disk mostly stays in place (see docs/stylize.md)")
+def test_texture_is_kept_and_moves_with_the_shape(source, tmp_path):
+    frames = _run(moving, 5, source, tmp_path)
+    exemplar_contrast = np.mean([_local_contrast(source.rgb[i], source.segment[i] >= 0)
+                                 for i in range(source.frame_count)])
+    for frame in frames:
+        assert _local_contrast(frame.rgba, moving(frame.index) > 0.5) >= 0.8 * exemplar_contrast
+    # the disk moves 4 px: the last frame should match the first shifted by 4 px better than unshifted
+    first, last = frames[0].rgba[..., :3], frames[-1].rgba[..., :3]
+    inner = ndimage.binary_erosion(moving(0) > 0.5, iterations=4)
+    inner_shifted = np.roll(inner, 4, axis=1)
+    both = inner & inner_shifted
+    assert np.abs(np.roll(first, 4, axis=1) - last)[both].mean() < np.abs(first - last)[both].mean()
+
+
+def test_stationary_regions_change_far_less_with_the_temporal_term(source, tmp_path):
+    def still(j):
+        return _disk(SIZE / 2)
+
+    def change(frames):
+        inside = still(0) > 0.5
+        return np.mean([np.abs(a.rgba - b.rgba)[inside].mean() for a, b in zip(frames, frames[1:])])
+
+    coherent = change(_run(still, 4, source, tmp_path))
+    independent = change(_run(still, 4, source, tmp_path, w_temp=0.0))
+    assert coherent < 0.6 * independent  # measured 0.51
+
+
+def test_deterministic_whatever_the_thread_count(source, tmp_path):
+    threads = numba.get_num_threads()
+    try:
+        numba.set_num_threads(1)
+        one = _run(moving, 3, source, tmp_path)
+        numba.set_num_threads(min(2, numba.config.NUMBA_NUM_THREADS))
+        two = _run(moving, 3, source, tmp_path)
+    finally:
+        numba.set_num_threads(threads)
+    for a, b in zip(one, two):
+        np.testing.assert_array_equal(a.rgba, b.rgba)
+        np.testing.assert_array_equal(a.nnf.frame, b.nnf.frame)
+        np.testing.assert_array_equal(a.nnf.coords, b.nnf.coords)
+
+
+def test_reverse_synthesizes_from_the_last_frame(source, tmp_path):
+    def growing(j):
+        return _disk(SIZE / 2, radius=8.0 + 2 * j)
+
+    backward = _run(growing, 4, source, tmp_path, reverse=True)
+    assert [f.index for f in backward] == [3, 2, 1, 0]
+    forward_on_reversed = _run(lambda j: growing(3 - j), 4, source, tmp_path)
+    for b, f in zip(backward, forward_on_reversed):
+        np.testing.assert_array_equal(b.rgba, f.rgba)
+
+
+def test_all_weights_zero_and_a_window_of_frames(source, tmp_path):
+    frames = list(stylize.stylize_sequence(
+        moving, 5, source, guide_params=GUIDES, cache_dir=tmp_path / "g", frames=(2, 4),
+        params=dataclasses.replace(FAST, w_bound=0, w_ext=0, w_dir=0, w_temp=0, w_uni=0)))
+    assert [f.index for f in frames] == [2, 3]
+    assert all(np.isfinite(f.rgba).all() and (f.nnf.frame[moving(f.index) > 0.5] >= 0).all() for f in frames)
+
+
+@pytest.mark.parametrize("change", [{"patch_size": 4}, {"w_temp": -1}, {"m_lower": 0.5, "m_upper": 0.1},
+                                    {"alpha": 1.0}, {"opt_iters": ()}])
+def test_bad_parameters_are_refused(change):
+    with pytest.raises(StageError):
+        dataclasses.replace(FAST, **change)
