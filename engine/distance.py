@@ -15,7 +15,7 @@ import numpy as np
 from numba import prange
 from scipy import ndimage
 
-from fluidymation.engine._jit import parallel_kernel
+from fluidymation.engine._jit import kernel, parallel_kernel
 
 #: Smallest |distance| given to a pixel, so that inside is exactly ``dist > 0``.
 _MIN_DISTANCE = 1e-4
@@ -98,11 +98,20 @@ def gaussian_blur(image: np.ndarray, *, sigma: float) -> np.ndarray:
 @parallel_kernel
 def _boundary_feet(coverage, threshold, mask, seed, foot_y, foot_x, normal_y, normal_x):
     """Mark pixels with a 4-neighbour on the other side of the mask as seeds and put
-    on each the foot of the perpendicular to the level set ``coverage = threshold``."""
+    on each the foot of the perpendicular to the level set ``coverage = threshold``
+    (the feet and normals are left unset on other pixels)."""
     height, width = mask.shape
     for y in prange(height):
         for x in range(width):
             inside = mask[y, x]
+            seed[y, x] = (
+                (x > 0 and mask[y, x - 1] != inside)
+                or (x < width - 1 and mask[y, x + 1] != inside)
+                or (y > 0 and mask[y - 1, x] != inside)
+                or (y < height - 1 and mask[y + 1, x] != inside)
+            )
+            if not seed[y, x]:
+                continue
             value = coverage[y, x] - threshold
             x0 = max(x - 1, 0)
             x1 = min(x + 1, width - 1)
@@ -140,40 +149,50 @@ def _boundary_feet(coverage, threshold, mask, seed, foot_y, foot_x, normal_y, no
                     best = reach
                     best_nx = towards_x
                     best_ny = towards_y
-            seed[y, x] = best < 2.0
             foot_x[y, x] = x + best * best_nx
             foot_y[y, x] = y + best * best_ny
             normal_x[y, x] = best_nx
             normal_y[y, x] = best_ny
 
 
+@kernel
+def _nearby_seeds(seed_index, seed_y, seed_x, counts, neighbours):
+    """For every seed, the seeds within ``_FOOT_SEARCH`` rows and columns of it (itself
+    included), in row-major order."""
+    height, width = seed_index.shape
+    for seed in range(seed_y.shape[0]):
+        count = 0
+        for cy in range(max(seed_y[seed] - _FOOT_SEARCH, 0), min(seed_y[seed] + _FOOT_SEARCH + 1, height)):
+            for cx in range(max(seed_x[seed] - _FOOT_SEARCH, 0), min(seed_x[seed] + _FOOT_SEARCH + 1, width)):
+                if seed_index[cy, cx] >= 0:
+                    neighbours[seed, count] = seed_index[cy, cx]
+                    count += 1
+        counts[seed] = count
+
+
 @parallel_kernel
-def _distance_to_feet(nearest, seed, foot_y, foot_x, normal_y, normal_x, mask, out):
+def _distance_to_feet(nearest, seed_index, counts, neighbours, feet, mask, out):
+    """``feet`` holds per seed its foot (y, x) and the boundary normal there (y, x)."""
     height, width = mask.shape
     for y in prange(height):
         for x in range(width):
             # the nearest boundary pixel by pixel centres need not have the nearest
             # foot: take the best foot among the boundary pixels around it
-            near_y = nearest[0, y, x]
-            near_x = nearest[1, y, x]
+            near = seed_index[nearest[0, y, x], nearest[1, y, x]]
             best_squared = np.inf
-            sy = near_y
-            sx = near_x
-            for cy in range(max(near_y - _FOOT_SEARCH, 0), min(near_y + _FOOT_SEARCH + 1, height)):
-                for cx in range(max(near_x - _FOOT_SEARCH, 0), min(near_x + _FOOT_SEARCH + 1, width)):
-                    if not seed[cy, cx]:
-                        continue
-                    squared = (y - foot_y[cy, cx]) ** 2 + (x - foot_x[cy, cx]) ** 2
-                    if squared < best_squared:
-                        best_squared = squared
-                        sy = cy
-                        sx = cx
-            dy = y - foot_y[sy, sx]
-            dx = x - foot_x[sy, sx]
+            best = near
+            for k in range(counts[near]):
+                candidate = neighbours[near, k]
+                squared = (y - feet[0, candidate]) ** 2 + (x - feet[1, candidate]) ** 2
+                if squared < best_squared:
+                    best_squared = squared
+                    best = candidate
+            dy = y - feet[0, best]
+            dx = x - feet[1, best]
             # distance to the boundary's tangent at the foot, unless the foot lies far
             # to the side (corners), where the distance to the foot itself is better
-            across = abs(dx * normal_x[sy, sx] + dy * normal_y[sy, sx])
-            sideways = abs(dx * normal_y[sy, sx] - dy * normal_x[sy, sx])
+            across = abs(dx * feet[3, best] + dy * feet[2, best])
+            sideways = abs(dx * feet[2, best] - dy * feet[3, best])
             length = across if sideways <= _TANGENT_REACH else math.sqrt(best_squared)
             length = max(length, _MIN_DISTANCE)
             out[y, x] = length if mask[y, x] else -length
@@ -213,8 +232,15 @@ def signed_distance(coverage: np.ndarray, *, threshold: float = 0.5) -> np.ndarr
     foot_y, foot_x, normal_y, normal_x = np.empty((4,) + mask.shape, dtype=np.float32)
     _boundary_feet(coverage, np.float32(threshold), mask, seed, foot_y, foot_x, normal_y, normal_x)
     nearest = ndimage.distance_transform_edt(~seed, return_distances=False, return_indices=True)
+    seed_y, seed_x = np.nonzero(seed)
+    seed_index = np.full(mask.shape, -1, dtype=np.int64)
+    seed_index[seed_y, seed_x] = np.arange(seed_y.size)
+    counts = np.empty(seed_y.size, dtype=np.int64)
+    neighbours = np.empty((seed_y.size, (2 * _FOOT_SEARCH + 1) ** 2), dtype=np.int64)
+    _nearby_seeds(seed_index, seed_y, seed_x, counts, neighbours)
+    feet = np.stack([array[seed_y, seed_x] for array in (foot_y, foot_x, normal_y, normal_x)])
     out = np.empty(mask.shape, dtype=np.float32)
-    _distance_to_feet(np.ascontiguousarray(nearest, dtype=np.int32), seed, foot_y, foot_x, normal_y, normal_x, mask, out)
+    _distance_to_feet(np.ascontiguousarray(nearest, dtype=np.int32), seed_index, counts, neighbours, feet, mask, out)
     return out
 
 
