@@ -1,9 +1,12 @@
 """The moving exemplar of a scene layer, with its guidance channels, from the user cache.
 
 A layer names its exemplar with ``exemplar:`` (its own or the scene defaults'); the
-``exemplars:`` section defines it. With no name the built-in ``watercolor-bloom`` with
-its default parameters is used. Generated built-in exemplars and their guides are kept
-under :func:`fluidymation.pipeline.paths.cache_dir`.
+``exemplars:`` section defines it: a built-in preset, or a recording (``video:`` a file,
+``images:`` a folder or pattern) with masks (``mask:`` an image sequence or ``auto``) and
+a flow estimated from the masks (``flow: masks``, the default) or from the frames
+(``flow: motion``). With no name the built-in ``watercolor-bloom`` with its default
+parameters is used. Generated built-in exemplars and all exemplar guides are kept under
+:func:`fluidymation.pipeline.paths.cache_dir`.
 """
 
 from __future__ import annotations
@@ -15,28 +18,31 @@ import os
 import shutil
 import tempfile
 
-from fluidymation.errors import SceneError
+from fluidymation.errors import SceneError, StageError
 from fluidymation.pipeline import paths
 from fluidymation.pipeline.commands.exemplar import resolve_params
 from fluidymation.pipeline.resolve import Plan, PlannedLayer
-from fluidymation.stages import exemplar_builtin, guides, stylize
+from fluidymation.stages import exemplar_builtin, exemplar_user, guides, stylize
 
 DEFAULT_BUILTIN = "watercolor-bloom"
 _BUILTIN_OPTIONS = ("kind", "builtin", "seed", "size", "frames", "color", "wetness")
+_USER_OPTIONS = ("kind", "path", "mask", "flow", "scale", "step", "frames", "reverse", "seed")
 
 
-def builtin_params(plan: Plan, layer: PlannedLayer) -> exemplar_builtin.Params:
-    """The built-in exemplar parameters the layer asks for (SceneError for other kinds)."""
+def exemplar_spec(plan: Plan, layer: PlannedLayer) -> tuple[str, dict]:
+    """The name and scene entry of the layer's exemplar (the default built-in when it names none)."""
     name = layer.spec.exemplar
     if name is None:
-        return resolve_params(DEFAULT_BUILTIN)
+        return DEFAULT_BUILTIN, {"kind": "builtin", "builtin": DEFAULT_BUILTIN}
     spec = plan.scene.exemplars.get(name)
     if spec is None:
         raise SceneError(f"{plan.scene.path}: layer '{layer.name}' uses exemplar '{name}', which the exemplars "
                          "section does not define")
-    if spec["kind"] != "builtin":
-        raise SceneError(f"{plan.scene.path}: exemplars.{name}: {spec['kind']} exemplars are not supported by the "
-                         "stylize stage yet; use a builtin one (see `fluidymation exemplar list`)")
+    return name, spec
+
+
+def builtin_params(plan: Plan, name: str, spec: dict) -> exemplar_builtin.Params:
+    """The built-in exemplar parameters of a ``builtin:`` entry."""
     unsupported = sorted(set(spec) - set(_BUILTIN_OPTIONS))
     if unsupported:
         raise SceneError(f"{plan.scene.path}: exemplars.{name}.{unsupported[0]}: not supported for builtin "
@@ -47,22 +53,74 @@ def builtin_params(plan: Plan, layer: PlannedLayer) -> exemplar_builtin.Params:
                           color=spec.get("color"), wetness=spec.get("wetness"))
 
 
+def simulated_frame_count(plan: Plan, layer: PlannedLayer) -> int | None:
+    """Frames the layer's exemplar simulates when it is a built-in one (for progress bars)."""
+    name, spec = exemplar_spec(plan, layer)
+    return builtin_params(plan, name, spec).frames if spec["kind"] == "builtin" else None
+
+
+def user_params(plan: Plan, name: str, spec: dict) -> exemplar_user.Params:
+    """How to read a ``video:`` or ``images:`` entry."""
+    where = f"{plan.scene.path}: exemplars.{name}"
+    unsupported = sorted(set(spec) - set(_USER_OPTIONS))
+    if unsupported:
+        raise SceneError(f"{where}.{unsupported[0]}: not an option of recorded exemplars; they take mask, flow, "
+                         "scale, step, frames, reverse and seed")
+    if spec.get("flow", "masks") == "exact":
+        raise SceneError(f"{where}.flow: 'exact' is only known for built-in exemplars; use masks or motion")
+    step = spec.get("step", 1)
+    if step != int(step):
+        raise SceneError(f"{where}.step: must be a whole number of source frames, got {step}")
+    frames = spec.get("frames", (0, None))
+    if isinstance(frames, int):
+        frames = (0, frames)
+    try:
+        return exemplar_user.Params(source=str(spec["path"]), mask=str(spec.get("mask", "auto")),
+                                    scale=spec.get("scale", 1.0), step=int(step), start=frames[0], end=frames[1],
+                                    reverse=spec.get("reverse", False))
+    except StageError as exc:
+        raise SceneError(f"{where}: {exc}") from None
+
+
 def layer_source(plan: Plan, layer: PlannedLayer, guide_params: guides.Params, *, progress=None) -> stylize.Source:
     """The layer's exemplar and its guides, generated on first use and cached.
 
     ``progress`` is called with no arguments after each simulated exemplar frame.
     """
-    params = builtin_params(plan, layer)
-    exemplar = exemplar_builtin.make_builtin_exemplar(params, cache_dir=paths.exemplar_cache_dir(), progress=progress)
-    record = json.dumps({"exemplar": params.cache_key(), "guides": dataclasses.asdict(guide_params),
+    name, spec = exemplar_spec(plan, layer)
+    if spec["kind"] == "builtin":
+        params = builtin_params(plan, name, spec)
+        exemplar = exemplar_builtin.make_builtin_exemplar(params, cache_dir=paths.exemplar_cache_dir(),
+                                                          progress=progress)
+        rgb, masks, flow, identity = exemplar.rgb, exemplar.mask, exemplar.flow, params.cache_key()
+    else:
+        params = user_params(plan, name, spec)
+        recording = exemplar_user.load_user_exemplar(params)
+        rgb, masks = recording.rgb, recording.mask
+        flow = exemplar_user.motion_flow(rgb, seed=spec.get("seed", 0)) if spec.get("flow") == "motion" else None
+        identity = _recording_identity(params, spec)
+    return _with_guides(rgb, masks, flow, identity, guide_params)
+
+
+def _recording_identity(params: exemplar_user.Params, spec: dict) -> str:
+    """A cache key for a recording: its reading options, flow choice and the files' sizes and times."""
+    stamps = [(str(p), p.stat().st_size, p.stat().st_mtime_ns) for p in exemplar_user.sequence_paths(params.source)]
+    record = json.dumps({"params": dataclasses.asdict(params), "flow": spec.get("flow", "masks"),
+                         "seed": spec.get("seed", 0), "files": stamps}, sort_keys=True, default=str)
+    return "recording-" + hashlib.sha256(record.encode()).hexdigest()[:16]
+
+
+def _with_guides(rgb, masks, flow, identity: str, guide_params: guides.Params) -> stylize.Source:
+    """The exemplar's guides from the cache, computed (from ``flow``, or the masks) on first use."""
+    record = json.dumps({"exemplar": identity, "guides": dataclasses.asdict(guide_params),
                          "version": guides.VERSION}, sort_keys=True)
-    entry = paths.exemplar_guides_cache_dir() / f"{params.cache_key()}-{hashlib.sha256(record.encode()).hexdigest()[:12]}"
+    entry = paths.exemplar_guides_cache_dir() / f"{identity}-{hashlib.sha256(record.encode()).hexdigest()[:12]}"
     if not (entry / "done").is_file():
         entry.parent.mkdir(parents=True, exist_ok=True)
         staging = tempfile.mkdtemp(prefix=f".{entry.name}.", dir=entry.parent)
         try:
-            guides.compute_guides(lambda j: exemplar.mask[j], params.frames, params=guide_params, cache_dir=staging,
-                                  given_flow=lambda j: exemplar.flow[j])
+            guides.compute_guides(lambda j: masks[j], len(masks), params=guide_params, cache_dir=staging,
+                                  given_flow=None if flow is None else (lambda j: flow[j]))
             with open(f"{staging}/done", "w") as handle:
                 handle.write(record)
             try:
@@ -72,4 +130,4 @@ def layer_source(plan: Plan, layer: PlannedLayer, guide_params: guides.Params, *
                     raise
         finally:
             shutil.rmtree(staging, ignore_errors=True)
-    return stylize.prepare_source(exemplar.rgb, guides.GuideCache.open(entry))
+    return stylize.prepare_source(rgb, guides.GuideCache.open(entry))

@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from fluidymation.errors import InputError
-from fluidymation.pipeline.exemplars import builtin_params, layer_source
+from fluidymation.pipeline.exemplars import layer_source, simulated_frame_count
 from fluidymation.pipeline.parameters import check_layer_params, layer_guide_params, layer_stylize_params
 from fluidymation.pipeline.progress import progress
 from fluidymation.pipeline.resolve import parse_window, plan_scene
@@ -96,7 +96,7 @@ def stylize_layer(plan, layer, window, coverage, out_dir: Path, *, quiet=False, 
     """Stylize one layer over a window of scene frames into ``out_dir``; return the files written by index."""
     guide_params = layer_guide_params(plan, layer)
     params = layer_stylize_params(plan, layer, **overrides)
-    with progress(builtin_params(plan, layer).frames, f"exemplar for {layer.name}", quiet=quiet) as bar:
+    with progress(simulated_frame_count(plan, layer), f"exemplar for {layer.name}", quiet=quiet) as bar:
         source = layer_source(plan, layer, guide_params, progress=bar.update)
     written = {}
     plan.scene.output.dir.mkdir(parents=True, exist_ok=True)
