@@ -37,8 +37,18 @@ _TILE = 8
 _STILL = 1e-4
 
 
+@kernel
+def _weighted(dists, weights, y, x):
+    """``sum_k weights[k] · dists[k, y, x]``, skipping zero weights."""
+    total = np.float32(0.0)
+    for slot in range(weights.shape[0]):
+        if weights[slot] != 0.0:
+            total += weights[slot] * dists[slot, y, x]
+    return total
+
+
 @parallel_kernel
-def _boundary_velocity(dist_prev, dist_cur, mask, flow, state):
+def _boundary_velocity(dists, prev_weights, cur_weights, mask, flow, state):
     height, width = mask.shape
     for y in prange(height):
         for x in range(width):
@@ -61,12 +71,12 @@ def _boundary_velocity(dist_prev, dist_cur, mask, flow, state):
             x1 = min(x + 1, width - 1)
             y0 = max(y - 1, 0)
             y1 = min(y + 1, height - 1)
-            grad_x = (dist_cur[y, x1] - dist_cur[y, x0]) / max(x1 - x0, 1)
-            grad_y = (dist_cur[y1, x] - dist_cur[y0, x]) / max(y1 - y0, 1)
+            grad_x = (_weighted(dists, cur_weights, y, x1) - _weighted(dists, cur_weights, y, x0)) / max(x1 - x0, 1)
+            grad_y = (_weighted(dists, cur_weights, y1, x) - _weighted(dists, cur_weights, y0, x)) / max(y1 - y0, 1)
             norm = math.sqrt(grad_x * grad_x + grad_y * grad_y)
             if norm < 1e-6:
                 continue
-            change = dist_cur[y, x] - dist_prev[y, x]
+            change = _weighted(dists, cur_weights, y, x) - _weighted(dists, prev_weights, y, x)
             if abs(change) <= _STILL:
                 continue
             speed = -change / norm
@@ -306,19 +316,45 @@ def flow_from_distances(
     (H, W, 2) float32
         ``(dx, dy)`` in px/frame, pointing the way the boundary moves.
     """
-    dist_prev = np.ascontiguousarray(dist_prev, dtype=np.float32)
-    dist_cur = np.ascontiguousarray(dist_cur, dtype=np.float32)
+    one_hot = np.eye(2, dtype=np.float32)
+    return flow_from_distance_stack(np.stack([dist_prev, dist_cur]), one_hot[0], one_hot[1], mask, sweeps=sweeps)
+
+
+def flow_from_distance_stack(
+    dists: np.ndarray, prev_weights: np.ndarray, cur_weights: np.ndarray, mask: np.ndarray, *, sweeps: int = 8
+) -> np.ndarray:
+    """:func:`flow_from_distances` of two weighted sums of a stack of distance fields.
+
+    ``dist_prev = sum_k prev_weights[k] · dists[k]`` and likewise ``dist_cur``, e.g.
+    temporal filters over a ring of frames; the sums are only evaluated on the boundary,
+    where they are needed.
+
+    Parameters
+    ----------
+    dists : (K, H, W) float32
+    prev_weights, cur_weights : (K,) float32
+    mask, sweeps
+        As for :func:`flow_from_distances`.
+
+    Returns
+    -------
+    (H, W, 2) float32
+    """
+    dists = np.ascontiguousarray(dists, dtype=np.float32)
+    prev_weights = np.ascontiguousarray(prev_weights, dtype=np.float32)
+    cur_weights = np.ascontiguousarray(cur_weights, dtype=np.float32)
     mask = np.ascontiguousarray(mask, dtype=np.bool_)
-    if mask.ndim != 2 or dist_prev.shape != mask.shape or dist_cur.shape != mask.shape:
+    if mask.ndim != 2 or dists.ndim != 3 or dists.shape[1:] != mask.shape:
+        raise ValueError(f"flow_from_distances: shapes do not fit: dists {dists.shape}, mask {mask.shape}")
+    if prev_weights.shape != dists.shape[:1] or cur_weights.shape != dists.shape[:1]:
         raise ValueError(
-            f"flow_from_distances: shapes differ or are not (H, W): "
-            f"{dist_prev.shape}, {dist_cur.shape}, {mask.shape}"
+            f"flow_from_distances: {prev_weights.shape} and {cur_weights.shape} weights for {dists.shape[0]} fields"
         )
     if sweeps < 1:
         raise ValueError(f"sweeps must be at least 1, got {sweeps}")
     flow = np.empty(mask.shape + (2,), dtype=np.float32)
     state = np.empty(mask.shape, dtype=np.int8)
-    _boundary_velocity(dist_prev, dist_cur, mask, flow, state)
+    _boundary_velocity(dists, prev_weights, cur_weights, mask, flow, state)
     _fill_interior(flow, state, sweeps=sweeps)
     return flow
 

@@ -213,16 +213,22 @@ class _Window:
             raise RuntimeError(f"frame {index} already left the window (depth {self.depth})")
         return self.ring[index % self.depth]
 
-    def smoothed(self, center: int, taps: np.ndarray) -> np.ndarray:
-        """``sum_k taps[k] · frame[center + k − r]`` with clamped frame indices."""
+    def slot_weights(self, center: int, taps: np.ndarray) -> np.ndarray:
+        """Weights of the ring's slots that make ``sum_k taps[k] · frame[center + k − r]``
+        (frame indices clamped); valid until the ring moves on."""
         radius = taps.shape[0] // 2
         self.get(center + radius)
-        slot_weights = np.zeros(self.depth, dtype=np.float32)
+        weights = np.zeros(self.depth, dtype=np.float32)
         for offset in range(-radius, radius + 1):
             index = self._clamp(center + offset)
             self.get(index)
-            slot_weights[index % self.depth] += taps[offset + radius]
-        return flow_kernels.weighted_sum(self.ring, slot_weights)
+            weights[index % self.depth] += taps[offset + radius]
+        return weights
+
+    def smoothed(self, center: int, taps: np.ndarray) -> np.ndarray:
+        """``sum_k taps[k] · frame[center + k − r]`` with clamped frame indices."""
+        weights = self.slot_weights(center, taps)
+        return flow_kernels.weighted_sum(self.ring, weights)
 
 
 def _item_getter(source, what: str) -> Callable[[int], Any]:
@@ -312,18 +318,20 @@ def compute_guides(
         return distance.signed_distance(blurred, threshold=params.threshold)
 
     dists = _Window(frame_count, 2 * dist_radius + flow_radius + 3, produce_dist)
-    smoothed_dists = _Window(frame_count, 3, lambda index: dists.smoothed(index, dist_taps))
 
     def produce_raw_flow(index: int) -> np.ndarray:
         mask = dists.get(index) > 0
-        if index == 0:
-            # motion to the next frame, seen on this frame's boundary
-            return -flow_kernels.flow_from_distances(
-                smoothed_dists.get(1), smoothed_dists.get(0), mask, sweeps=params.relax_sweeps
-            )
-        return flow_kernels.flow_from_distances(
-            smoothed_dists.get(index - 1), smoothed_dists.get(index), mask, sweeps=params.relax_sweeps
+        # between the distances smoothed along time around two frames; the first frame
+        # takes the motion to the next one, seen on its own boundary
+        prev_frame, cur_frame = (1, 0) if index == 0 else (index - 1, index)
+        motion = flow_kernels.flow_from_distance_stack(
+            dists.ring,
+            dists.slot_weights(prev_frame, dist_taps),
+            dists.slot_weights(cur_frame, dist_taps),
+            mask,
+            sweeps=params.relax_sweeps,
         )
+        return -motion if index == 0 else motion
 
     raw_flows = _Window(frame_count, 2 * flow_radius + 1, produce_raw_flow)
 
@@ -339,16 +347,16 @@ def compute_guides(
             frame_flow = raw_flows.smoothed(index, flow_taps)
         else:
             frame_flow = _given_flow(get_flow(index), index, shape)
-        frame_dist = dists.get(index).copy()
+        frame_dist = dists.get(index)
         mask = frame_dist > 0
         ext_plus = extent.accumulate_extent(accumulator, frame_flow if index > 0 else zero_flow, mask)
         cache.write("dist", index, frame_dist)
         cache.write("shape", index, distance.shape_channel(mask, radius=params.shape_radius * scale))
         cache.write("flow", index, frame_flow)
         cache.write("ext_plus", index, ext_plus)
-        flow_max = max(flow_max, float(np.sqrt((frame_flow**2).sum(axis=2).max())))
+        flow_max = max(flow_max, float(np.sqrt(np.max(frame_flow[:, :, 0] ** 2 + frame_flow[:, :, 1] ** 2))))
         ext_plus_max = max(ext_plus_max, float(ext_plus.max()))
-        dist_max = max(dist_max, float(np.abs(frame_dist).max()))
+        dist_max = max(dist_max, float(frame_dist.max()), -float(frame_dist.min()))
         if progress is not None:
             progress(index + 1, total)
 

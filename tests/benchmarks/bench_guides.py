@@ -19,15 +19,22 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 
 def _blob_masks(width, height):
-    yy, xx = np.mgrid[:height, :width].astype(np.float32)
+    largest_radius = 220 + 40 + 30
 
     def mask(index):
         t = index / 24.0
         cx = width / 2 + 180 * np.sin(t)
         cy = height / 2 + 60 * np.cos(1.3 * t)
+        # only the blob's bounding box is evaluated, so that making the masks costs
+        # little next to the guides being timed
+        top, left = max(int(cy) - largest_radius, 0), max(int(cx) - largest_radius, 0)
+        yy, xx = np.mgrid[top: int(cy) + largest_radius + 2, left: int(cx) + largest_radius + 2].astype(np.float32)
         angle = np.arctan2(yy - cy, xx - cx)
         radius = 220 + 40 * np.sin(3 * angle + t) + 30 * np.sin(t / 2)
-        return np.hypot(xx - cx, yy - cy) < radius
+        out = np.zeros((height, width), dtype=bool)
+        inside = np.hypot(xx - cx, yy - cy) < radius
+        out[top: top + yy.shape[0], left: left + yy.shape[1]] = inside[: height - top, : width - left]
+        return out
 
     return mask
 
