@@ -121,30 +121,43 @@ def _restrict_values(state, values, coarse_state, coarse_values):
 
 
 @kernel
+def _coarse_neighbours(length, coarse_length):
+    """Per fine index along one axis: the two coarse cells around its centre and the
+    weight of the second (bilinear interpolation, clamped at the ends)."""
+    first = np.empty(length, dtype=np.int64)
+    second = np.empty(length, dtype=np.int64)
+    weight = np.empty(length, dtype=np.float32)
+    for i in range(length):
+        centre = 0.5 * i - 0.25  # in coarse cell coordinates
+        first[i] = min(max(int(math.floor(centre)), 0), coarse_length - 1)
+        second[i] = min(first[i] + 1, coarse_length - 1)
+        weight[i] = min(max(centre - first[i], 0.0), 1.0)
+    return first, second, weight
+
+
+@kernel
 def _prolong(coarse_state, coarse_values, state, values):
     """Bilinear interpolation onto the unknown fine cells, ignoring outside coarse cells."""
     height, width = state.shape
-    coarse_height, coarse_width = coarse_state.shape
+    cy0s, cy1s, wy1s = _coarse_neighbours(height, coarse_state.shape[0])
+    cx0s, cx1s, wx1s = _coarse_neighbours(width, coarse_state.shape[1])
     for y in range(height):
-        # pixel centre in coarse pixel coordinates
-        cy_f = 0.5 * y - 0.25
-        cy0 = min(max(int(math.floor(cy_f)), 0), coarse_height - 1)
-        cy1 = min(cy0 + 1, coarse_height - 1)
-        wy1 = min(max(cy_f - cy0, 0.0), 1.0)
+        cy0 = cy0s[y]
+        cy1 = cy1s[y]
+        wy1 = wy1s[y]
         for x in range(width):
             if state[y, x] != _UNKNOWN:
                 continue
-            cx_f = 0.5 * x - 0.25
-            cx0 = min(max(int(math.floor(cx_f)), 0), coarse_width - 1)
-            cx1 = min(cx0 + 1, coarse_width - 1)
-            wx1 = min(max(cx_f - cx0, 0.0), 1.0)
-            total_weight = 0.0
-            total = 0.0
+            cx0 = cx0s[x]
+            cx1 = cx1s[x]
+            wx1 = wx1s[x]
+            total_weight = np.float32(0.0)
+            total = np.float32(0.0)
             for corner in range(4):
                 cy = cy1 if corner >= 2 else cy0
                 cx = cx1 if corner % 2 == 1 else cx0
-                weight = (wy1 if corner >= 2 else 1.0 - wy1) * (wx1 if corner % 2 == 1 else 1.0 - wx1)
-                if coarse_state[cy, cx] != _OUTSIDE and weight > 0.0:
+                weight = (wy1 if corner >= 2 else 1 - wy1) * (wx1 if corner % 2 == 1 else 1 - wx1)
+                if coarse_state[cy, cx] != _OUTSIDE:
                     total_weight += weight
                     total += weight * coarse_values[cy, cx]
             values[y, x] = total / total_weight if total_weight > 0.0 else coarse_values[y // 2, x // 2]
