@@ -3,9 +3,33 @@
 ``kernel`` compiles serial code; ``parallel_kernel`` adds ``prange`` support. Both are
 cached on disk (``NUMBA_CACHE_DIR`` selects where) and use fastmath. Kernels that run
 in parallel must write disjoint slices so results do not depend on the thread count.
+``prefetch`` asks the CPU to start loading an array element's cache line.
 """
 
 import numba
+from llvmlite import ir
+from numba import types
+from numba.core import cgutils
+from numba.extending import intrinsic
 
 kernel = numba.njit(cache=True, fastmath=True, nogil=True)
 parallel_kernel = numba.njit(cache=True, fastmath=True, nogil=True, parallel=True)
+
+
+@intrinsic
+def prefetch(typingctx, array, index):
+    """Hint that ``array.ravel()[index]`` (C-contiguous ``array``) will soon be read."""
+    if not isinstance(array, types.Array) or array.layout != "C" or not isinstance(index, types.Integer):
+        return None
+
+    def codegen(context, builder, signature, args):
+        data = context.make_array(signature.args[0])(context, builder, args[0]).data
+        offset = context.cast(builder, args[1], signature.args[1], types.intp)
+        address = builder.bitcast(builder.gep(data, [offset]), ir.IntType(8).as_pointer())
+        function_type = ir.FunctionType(ir.VoidType(), [address.type] + [ir.IntType(32)] * 3)
+        function = cgutils.get_or_insert_function(builder.module, function_type, "llvm.prefetch.p0")
+        read, keep_in_all_caches, data_cache = (ir.Constant(ir.IntType(32), value) for value in (0, 3, 1))
+        builder.call(function, [address, read, keep_in_all_caches, data_cache])
+        return context.get_dummy_value()
+
+    return types.void(array, index), codegen

@@ -31,26 +31,28 @@ from dataclasses import dataclass, replace
 import numpy as np
 from numba import prange
 
-from fluidymation.engine._jit import kernel, parallel_kernel
+from fluidymation.engine._jit import kernel, parallel_kernel, prefetch
 from fluidymation.engine.nnf import ROTATION_FLOW, _flow_rotation
 from fluidymation.engine.random import _key4, _random_below
 from fluidymation.engine.sampling import _bilinear_setup
 
 TILE_ROWS = 16
-_INF = np.float32(np.inf)
+_CODE = np.uint16
+_CODE_MAX = float(np.iinfo(_CODE).max)
 
 
 @kernel
-def _window_ssd(source_rows, target_rows, source_row, source_column, target_row, target_column, size, length, bound):
-    """SSD of two n×n windows of all features, rows read as contiguous runs of n·F values."""
+def _window_ssd(source_rows, target_rows, run_weights, source_row, source_column, target_row, target_column, size,
+                length, bound):
+    """Weighted SSD of two n×n windows of all features, rows read as contiguous runs of n·F codes."""
     total = np.float32(0.0)
     for dy in range(size):
         source_run = source_rows[source_row + dy, source_column:source_column + length]
         target_run = target_rows[target_row + dy, target_column:target_column + length]
         row_total = np.float32(0.0)
         for k in range(length):
-            d = source_run[k] - target_run[k]
-            row_total += d * d
+            d = np.float32(source_run[k]) - np.float32(target_run[k])
+            row_total += run_weights[k] * d * d
         total += row_total
         if total > bound:
             return total
@@ -59,8 +61,8 @@ def _window_ssd(source_rows, target_rows, source_row, source_column, target_row,
 
 @kernel
 def _patch_cost(
-    source, target, source_rows, target_rows, feature_start, plain_end, group_ends, weight_maps, opposite_feature,
-    source_angle, target_angle, orientation_weight, orientation_clamp, use_opposite,
+    source, target, source_rows, target_rows, feature_weights, run_weights, feature_start, plain_end, group_ends,
+    weight_maps, opposite_feature, source_angle, target_angle, orientation_weight, orientation_clamp, use_opposite,
     radius, tx, ty, frame, x, y, theta, bound,
 ):
     height = target.shape[0]
@@ -85,7 +87,7 @@ def _patch_cost(
             and radius <= tx < width - radius and radius <= ty < height - radius
         ):
             return _window_ssd(
-                source_rows, target_rows, frame * source_height + sy - radius, (sx - radius) * features,
+                source_rows, target_rows, run_weights, frame * source_height + sy - radius, (sx - radius) * features,
                 ty - radius, (tx - radius) * features, 2 * radius + 1, (2 * radius + 1) * features, bound,
             )
         for dy in range(-radius, radius + 1):
@@ -99,14 +101,14 @@ def _patch_cost(
                     continue
                 px = sx + dx
                 for c in range(feature_start, plain_end):
-                    d = source[frame, py, px, c] - target[qy, qx, c]
-                    total += d * d
+                    d = np.float32(source[frame, py, px, c]) - np.float32(target[qy, qx, c])
+                    total += feature_weights[c] * d * d
                 start = plain_end
                 for g in range(groups):
                     part = np.float32(0.0)
                     for c in range(max(start, feature_start), group_ends[g]):
-                        d = source[frame, py, px, c] - target[qy, qx, c]
-                        part += d * d
+                        d = np.float32(source[frame, py, px, c]) - np.float32(target[qy, qx, c])
+                        part += feature_weights[c] * d * d
                     total += weight_maps[g, qy, qx] * part
                     start = group_ends[g]
             if total > bound:
@@ -137,8 +139,8 @@ def _patch_cost(
                         + w01 * source[frame, y1, x0, sc]
                         + w11 * source[frame, y1, x1, sc]
                     )
-                    d = value - target[qy, qx, c]
-                    part += d * d
+                    d = value - np.float32(target[qy, qx, c])
+                    part += feature_weights[c] * d * d
                 total += part if g < 0 else weight_maps[g, qy, qx] * part
                 start = max(end, feature_start)
             if orientation_weight > 0.0:
@@ -153,8 +155,9 @@ def _patch_cost(
 
 @parallel_kernel
 def _evaluate(
-    source, target, source_rows, target_rows, feature_start, plain_end, group_ends, weight_maps, opposite_feature,
-    source_angle, target_angle, orientation_weight, orientation_clamp, use_opposite, radius,
+    source, target, source_rows, target_rows, feature_weights, run_weights, feature_start, plain_end, group_ends,
+    weight_maps, opposite_feature, source_angle, target_angle, orientation_weight, orientation_clamp, use_opposite,
+    radius,
     nnf_frame, nnf_coords, out,
 ):
     height, width = nnf_frame.shape
@@ -165,10 +168,20 @@ def _evaluate(
                 out[ty, tx] = np.inf
                 continue
             out[ty, tx] = _patch_cost(
-                source, target, source_rows, target_rows, feature_start, plain_end, group_ends, weight_maps,
-                opposite_feature, source_angle, target_angle, orientation_weight, orientation_clamp, use_opposite,
-                radius, tx, ty, frame, nnf_coords[ty, tx, 0], nnf_coords[ty, tx, 1], nnf_coords[ty, tx, 2], np.inf,
+                source, target, source_rows, target_rows, feature_weights, run_weights, feature_start, plain_end,
+                group_ends, weight_maps, opposite_feature, source_angle, target_angle, orientation_weight,
+                orientation_clamp, use_opposite, radius,
+                tx, ty, frame, nnf_coords[ty, tx, 0], nnf_coords[ty, tx, 1], nnf_coords[ty, tx, 2], np.inf,
             )
+
+
+@kernel
+def _prefetch_candidate(source_segment, penalty, use_penalty, frame, x, y):
+    """Start loading the label and the penalty of an integer candidate."""
+    pixel = (frame * source_segment.shape[1] + y) * source_segment.shape[2] + x
+    prefetch(source_segment, pixel)
+    if use_penalty:
+        prefetch(penalty, pixel)
 
 
 @kernel
@@ -180,8 +193,9 @@ def _penalty_at(penalty, use_penalty, frame, x, y):
 
 @parallel_kernel
 def _search(
-    source, target, source_rows, target_rows, feature_start, plain_end, group_ends, weight_maps, opposite_feature,
-    source_angle, target_angle, orientation_weight, orientation_clamp, use_opposite, radius,
+    source, target, source_rows, target_rows, feature_weights, run_weights, feature_start, plain_end, group_ends,
+    weight_maps, opposite_feature, source_angle, target_angle, orientation_weight, orientation_clamp, use_opposite,
+    radius,
     source_segment, target_segment, penalty, use_penalty,
     nnf_frame, nnf_coords, error, start_frame, start_coords,
     rotation_mode, alpha, seed, salt, reverse, tile_rows,
@@ -190,10 +204,15 @@ def _search(
     frames, source_height, source_width = source_segment.shape
     high_x = np.float32(source_width - 1)
     high_y = np.float32(source_height - 1)
-    longest = max(source_width, source_height)
+    boxes = 0
+    scale = 1.0
+    while scale * max(source_width, source_height) >= 1.0:
+        boxes += 1
+        scale *= alpha
     step = -1 if reverse else 1
     tiles = (height + tile_rows - 1) // tile_rows
     for tile in prange(tiles):
+        draws = np.empty((boxes, 3), np.int64)
         y_begin = tile * tile_rows
         y_end = min(height, y_begin + tile_rows)
         for row in range(y_end - y_begin):
@@ -247,9 +266,9 @@ def _search(
                     if cand_penalty >= best_total:
                         continue
                     cand_error = _patch_cost(
-                        source, target, source_rows, target_rows, feature_start, plain_end, group_ends,
-                        weight_maps, opposite_feature, source_angle, target_angle, orientation_weight,
-                        orientation_clamp, use_opposite, radius,
+                        source, target, source_rows, target_rows, feature_weights, run_weights, feature_start,
+                        plain_end, group_ends, weight_maps, opposite_feature, source_angle, target_angle,
+                        orientation_weight, orientation_clamp, use_opposite, radius,
                         tx, ty, cand_frame, cx, cy, cand_theta, best_total - cand_penalty,
                     )
                     if cand_error + cand_penalty < best_total:
@@ -259,27 +278,34 @@ def _search(
                         best_theta = cand_theta
                         best_error = cand_error
                         best_total = cand_error + cand_penalty
-                # random search in shrinking boxes over (frame, x, y)
+                # random search in boxes shrinking by alpha around the match after propagation (as
+                # EbSynth): draw every candidate and start loading its label and penalty (cache
+                # misses), then try the smallest box first
                 key = _key4(seed, salt, ty, tx)
-                draw = 0
+                centre_x = int(best_x + 0.5)
+                centre_y = int(best_y + 0.5)
+                centre_frame = best_frame
                 scale = 1.0
-                while scale * longest >= 1.0:
+                for box in range(boxes):
                     half_x = scale * source_width
                     half_y = scale * source_height
                     half_t = int(scale * frames)
-                    centre_x = int(best_x + 0.5)
-                    centre_y = int(best_y + 0.5)
                     x_lo = max(0, int(centre_x - half_x))
                     x_hi = min(source_width - 1, int(centre_x + half_x))
                     y_lo = max(0, int(centre_y - half_y))
                     y_hi = min(source_height - 1, int(centre_y + half_y))
-                    f_lo = max(0, best_frame - half_t)
-                    f_hi = min(frames - 1, best_frame + half_t)
-                    cx_int = x_lo + _random_below(key, draw, x_hi - x_lo + 1)
-                    cy_int = y_lo + _random_below(key, draw + 1, y_hi - y_lo + 1)
-                    cand_frame = f_lo + _random_below(key, draw + 2, f_hi - f_lo + 1)
-                    draw += 3
+                    f_lo = max(0, centre_frame - half_t)
+                    f_hi = min(frames - 1, centre_frame + half_t)
+                    draws[box, 0] = f_lo + _random_below(key, 3 * box + 2, f_hi - f_lo + 1)
+                    draws[box, 1] = x_lo + _random_below(key, 3 * box, x_hi - x_lo + 1)
+                    draws[box, 2] = y_lo + _random_below(key, 3 * box + 1, y_hi - y_lo + 1)
+                    _prefetch_candidate(source_segment, penalty, use_penalty, draws[box, 0], draws[box, 1],
+                                        draws[box, 2])
                     scale *= alpha
+                for box in range(boxes - 1, -1, -1):
+                    cand_frame = draws[box, 0]
+                    cx_int = draws[box, 1]
+                    cy_int = draws[box, 2]
                     if source_segment[cand_frame, cy_int, cx_int] != label:
                         continue
                     cx = np.float32(cx_int)
@@ -295,9 +321,9 @@ def _search(
                                 _flow_rotation(target_angle, source_angle, cand_frame, cx, cy, tx, ty, flip == 1)
                             )
                         cand_error = _patch_cost(
-                            source, target, source_rows, target_rows, feature_start, plain_end, group_ends,
-                            weight_maps, opposite_feature, source_angle, target_angle, orientation_weight,
-                            orientation_clamp, use_opposite, radius,
+                            source, target, source_rows, target_rows, feature_weights, run_weights, feature_start,
+                            plain_end, group_ends, weight_maps, opposite_feature, source_angle, target_angle,
+                            orientation_weight, orientation_clamp, use_opposite, radius,
                             tx, ty, cand_frame, cx, cy, cand_theta, best_total - cand_penalty,
                         )
                         if cand_error + cand_penalty < best_total:
@@ -319,16 +345,21 @@ class PatchCost:
     """Kernel-ready description of the patch distance at one pyramid level.
 
     Build it with :func:`build_patch_cost`. Features are ordered: colour, guides without
-    a weight map, then guides grouped by weight map; all are pre-multiplied by
-    ``sqrt(weight)``.
+    a weight map, then guides grouped by weight map. They are stored as 16-bit codes
+    ``round((value − offset) · scale)`` per feature, spanning the feature's range (the
+    random search is bound by memory traffic); the cost weighs squared code differences
+    by ``weight / scale²``.
 
     Attributes
     ----------
-    source_features : ndarray, shape (T, Hs, Ws, F), float32
-    target_features : ndarray, shape (H, W, F), float32
+    source_features : ndarray, shape (T, Hs, Ws, F), uint16
+    target_features : ndarray, shape (H, W, F), uint16
         Its first ``colour_channels`` features are rewritten after every vote.
-    colour_scale : ndarray, shape (Cc,), float32
-        ``sqrt`` of the colour weights.
+    feature_offset, feature_scale : ndarray, shape (F,), float32
+        Quantization of each feature; swapped features share theirs.
+    feature_weights : ndarray, shape (F,), float32
+        ``weight / scale²``: the weight of a squared code difference.
+    colour_channels : int
     plain_end : int
         Features ``[0, plain_end)`` have no per-pixel weight map.
     group_ends : ndarray, shape (M,), int64
@@ -349,7 +380,10 @@ class PatchCost:
 
     source_features: np.ndarray
     target_features: np.ndarray
-    colour_scale: np.ndarray
+    feature_offset: np.ndarray
+    feature_scale: np.ndarray
+    feature_weights: np.ndarray
+    colour_channels: int
     plain_end: int
     group_ends: np.ndarray
     weight_maps: np.ndarray
@@ -364,17 +398,15 @@ class PatchCost:
     patch_size: int
     feature_start: int = 0
 
-    @property
-    def colour_channels(self):
-        return self.colour_scale.shape[0]
-
     def guides_only(self):
         """The same cost with the colour features left out."""
         return replace(self, feature_start=self.colour_channels)
 
     def set_target_colour(self, colour):
         """Store the current target colour (H, W, Cc) float32 into the target features."""
-        np.multiply(colour, self.colour_scale, out=self.target_features[:, :, : self.colour_channels])
+        colours = self.colour_channels
+        _quantize(colour, self.feature_offset[:colours], self.feature_scale[:colours],
+                  self.target_features[:, :, :colours])
 
     def kernel_args(self):
         frames, source_height, source_width, features = self.source_features.shape
@@ -382,7 +414,8 @@ class PatchCost:
         return (
             self.source_features, self.target_features,
             self.source_features.reshape(frames * source_height, source_width * features),
-            self.target_features.reshape(height, width * features), self.feature_start, self.plain_end, self.group_ends,
+            self.target_features.reshape(height, width * features), self.feature_weights,
+            np.tile(self.feature_weights, self.patch_size), self.feature_start, self.plain_end, self.group_ends,
             self.weight_maps, self.opposite_feature, self.source_angle, self.target_angle,
             np.float32(self.orientation_weight), np.float32(self.orientation_clamp), self.use_opposite,
             self.patch_size // 2,
@@ -446,14 +479,8 @@ def build_patch_cost(*, source_colour, source_guides, target_colour, target_guid
     position[order] = np.arange(guides)
     group_ends = np.array([colours + np.count_nonzero(guide_weight_map <= m) for m in range(maps)], np.int64)
     plain_end = colours + int(np.count_nonzero(guide_weight_map < 0))
-    guide_scale = np.sqrt(guide_weights)[order]
-    colour_scale = np.sqrt(colour_weights)
-    source_features = np.empty((frames, source_height, source_width, colours + guides), np.float32)
-    np.multiply(source_colour, colour_scale, out=source_features[..., :colours])
-    np.multiply(source_guides[..., order], guide_scale, out=source_features[..., colours:])
-    target_features = np.empty((height, width, colours + guides), np.float32)
-    np.multiply(target_guides[..., order], guide_scale, out=target_features[..., colours:])
-    target_features[..., :colours] = np.asarray(target_colour, np.float32) * colour_scale
+    source_guides = source_guides[..., order]
+    target_guides = target_guides[..., order]
     opposite_feature = np.arange(colours + guides, dtype=np.int64)
     use_opposite = opposite_guide is not None
     if use_opposite:
@@ -461,6 +488,22 @@ def build_patch_cost(*, source_colour, source_guides, target_colour, target_guid
         if (guide_weights[opposite_guide] != guide_weights).any():
             raise ValueError("guides swapped by opposite_guide must have equal weights")
         opposite_feature[colours + position] = colours + position[opposite_guide]
+    # ranges span both sides; later votes, averages of source colours, stay inside
+    target_colour = np.asarray(target_colour, np.float32)
+    source_features = np.concatenate([source_colour, source_guides], axis=3)
+    target_features = np.concatenate([target_colour, target_guides], axis=2)
+    low = np.minimum(_channel_min(source_features), _channel_min(target_features))
+    high = np.maximum(_channel_max(source_features), _channel_max(target_features))
+    for _ in range(colours + guides):  # features swapped with each other share one range
+        low, high = np.minimum(low, low[opposite_feature]), np.maximum(high, high[opposite_feature])
+    span = high - low
+    scale = np.where(span > 0, _CODE_MAX / np.where(span > 0, span, 1.0), 1.0).astype(np.float32)
+    offset = low.astype(np.float32)
+    source_codes = np.empty(source_features.shape, _CODE)
+    _quantize(source_features, offset, scale, source_codes)
+    target_codes = np.empty(target_features.shape, _CODE)
+    _quantize(target_features, offset, scale, target_codes)
+    weights = np.concatenate([colour_weights, guide_weights[order]])
     needs_angles = use_opposite or orientation_weight > 0
     if needs_angles and (source_angle is None or target_angle is None):
         raise ValueError("the orientation term and opposite-flow swapping need source_angle and target_angle")
@@ -474,9 +517,12 @@ def build_patch_cost(*, source_colour, source_guides, target_colour, target_guid
     if weight_maps is None:
         weight_maps = np.zeros((0, height, width), np.float32)
     return PatchCost(
-        source_features=source_features,
-        target_features=target_features,
-        colour_scale=colour_scale,
+        source_features=source_codes,
+        target_features=target_codes,
+        feature_offset=offset,
+        feature_scale=scale,
+        feature_weights=(weights / scale.astype(np.float64) ** 2).astype(np.float32),
+        colour_channels=colours,
         plain_end=plain_end,
         group_ends=group_ends,
         weight_maps=np.ascontiguousarray(weight_maps, np.float32),
@@ -490,6 +536,22 @@ def build_patch_cost(*, source_colour, source_guides, target_colour, target_guid
         target_segment=np.ascontiguousarray(target_segment, np.int32),
         patch_size=int(patch_size),
     )
+
+
+def _channel_min(values):
+    return values.reshape(-1, values.shape[-1]).min(axis=0, initial=np.inf).astype(np.float64)
+
+
+def _channel_max(values):
+    return values.reshape(-1, values.shape[-1]).max(axis=0, initial=-np.inf).astype(np.float64)
+
+
+def _quantize(values, offset, scale, out):
+    """Store ``round((values − offset) · scale)``, clipped to the code range, into ``out``."""
+    codes = (np.asarray(values, np.float32) - offset) * scale
+    np.rint(codes, out=codes)
+    np.clip(codes, 0.0, _CODE_MAX, out=codes)
+    out[...] = codes
 
 
 def patch_errors(cost, nnf):
