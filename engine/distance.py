@@ -80,6 +80,8 @@ def gaussian_blur(image: np.ndarray, *, sigma: float) -> np.ndarray:
     """Blur an ``(H, W)`` image with a Gaussian of standard deviation ``sigma`` px.
 
     Separable, truncated at 3·sigma, edges extended by repeating the border pixel.
+    Only the bounding box of the nonzero pixels, widened by the kernel's radius, is
+    computed (masks are mostly zero); the rest of the result is zero.
     Returns float32 ``(H, W)``.
     """
     image = np.ascontiguousarray(image, dtype=np.float32)
@@ -88,10 +90,23 @@ def gaussian_blur(image: np.ndarray, *, sigma: float) -> np.ndarray:
     taps = gaussian_weights(sigma)
     if taps.shape[0] == 1:
         return image.copy()
-    rows = np.empty_like(image)
-    _blur_rows(image, taps, rows)
-    out = np.empty_like(image)
-    _blur_columns(rows, taps, out)
+    radius = taps.shape[0] // 2
+    out = np.zeros_like(image)
+    rows = np.flatnonzero(image.any(axis=1))
+    if rows.size == 0:
+        return out
+    columns = np.flatnonzero(image.any(axis=0))
+    box = (
+        slice(max(rows[0] - radius, 0), rows[-1] + radius + 1),
+        slice(max(columns[0] - radius, 0), columns[-1] + radius + 1),
+    )
+    # beyond the box the image is zero for at least a radius, so the box's own
+    # extended edges see the same zeros
+    crop = np.ascontiguousarray(image[box])
+    along_rows = np.empty_like(crop)
+    _blur_rows(crop, taps, along_rows)
+    _blur_columns(along_rows, taps, crop)
+    out[box] = crop
     return out
 
 

@@ -91,3 +91,17 @@ def test_edge_factor_and_segments():
     assert labels.tolist() == [[distance.OUTSIDE, distance.BORDER, distance.BORDER, distance.INTERIOR, distance.INTERIOR]]
     with pytest.raises(ValueError):
         distance.segments(dist, border_width=0.0)
+
+
+def test_gaussian_blur_of_a_small_shape_matches_scipy_everywhere():
+    # the blur computes only the box around the nonzero pixels
+    image = np.zeros((60, 70), dtype=np.float32)
+    image[20:26, 30:41] = 1.0
+    image[24, 5] = 0.5
+    expected = ndimage.gaussian_filter(image.astype(np.float64), 2.0, mode="nearest", truncate=3.0)
+    np.testing.assert_allclose(distance.gaussian_blur(image, sigma=2.0), expected, atol=1e-6)
+    edge = np.zeros((30, 30), dtype=np.float32)
+    edge[:4, 10:14] = 1.0
+    expected = ndimage.gaussian_filter(edge.astype(np.float64), 1.5, mode="nearest", truncate=3.0)
+    np.testing.assert_allclose(distance.gaussian_blur(edge, sigma=1.5), expected, atol=1e-6)
+    assert not distance.gaussian_blur(np.zeros((5, 6), dtype=np.float32), sigma=1.0).any()
