@@ -12,10 +12,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import prange
 from scipy import ndimage
 
-from fluidymation.engine._jit import kernel, parallel_kernel
+from fluidymation.engine._jit import kernel
 
 #: Smallest |distance| given to a pixel, so that inside is exactly ``dist > 0``.
 _MIN_DISTANCE = 1e-4
@@ -44,11 +43,11 @@ def gaussian_weights(sigma: float) -> np.ndarray:
     return (taps / taps.sum()).astype(np.float32)
 
 
-@parallel_kernel
+@kernel
 def _blur_rows(image, taps, out):
     height, width = image.shape
     radius = taps.shape[0] // 2
-    for y in prange(height):
+    for y in range(height):
         # the row extended by its end pixels, so the tap loop runs over contiguous memory
         padded = np.empty(width + 2 * radius, dtype=np.float32)
         padded[:radius] = image[y, 0]
@@ -62,11 +61,11 @@ def _blur_rows(image, taps, out):
                 out[y, x] += weight * padded[x + k]
 
 
-@parallel_kernel
+@kernel
 def _blur_columns(image, taps, out):
     height, width = image.shape
     radius = taps.shape[0] // 2
-    for y in prange(height):
+    for y in range(height):
         for x in range(width):
             out[y, x] = 0.0
         for k in range(-radius, radius + 1):
@@ -110,13 +109,13 @@ def gaussian_blur(image: np.ndarray, *, sigma: float) -> np.ndarray:
     return out
 
 
-@parallel_kernel
+@kernel
 def _boundary_feet(coverage, threshold, mask, seed, foot_y, foot_x, normal_y, normal_x):
     """Mark pixels with a 4-neighbour on the other side of the mask as seeds and put
     on each the foot of the perpendicular to the level set ``coverage = threshold``
     (the feet and normals are left unset on other pixels)."""
     height, width = mask.shape
-    for y in prange(height):
+    for y in range(height):
         for x in range(width):
             inside = mask[y, x]
             seed[y, x] = (
@@ -185,11 +184,11 @@ def _nearby_seeds(seed_index, seed_y, seed_x, counts, neighbours):
         counts[seed] = count
 
 
-@parallel_kernel
+@kernel
 def _distance_to_feet(nearest, seed_index, counts, neighbours, feet, mask, out):
     """``feet`` holds per seed its foot (y, x) and the boundary normal there (y, x)."""
     height, width = mask.shape
-    for y in prange(height):
+    for y in range(height):
         for x in range(width):
             # the nearest boundary pixel by pixel centres need not have the nearest
             # foot: take the best foot among the boundary pixels around it

@@ -10,15 +10,13 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import prange
-
-from fluidymation.engine._jit import parallel_kernel
+from fluidymation.engine._jit import kernel
 
 
-@parallel_kernel
+@kernel
 def _accumulate(accumulator, flow, mask, extent):
     height, width = mask.shape
-    for y in prange(height):
+    for y in range(height):
         for x in range(width):
             if mask[y, x]:
                 acc_x = accumulator[y, x, 0] + flow[y, x, 0]

@@ -18,9 +18,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import prange
-
-from fluidymation.engine._jit import kernel, parallel_kernel
+from fluidymation.engine._jit import kernel
 
 _OUTSIDE = 0
 _FIXED = 1
@@ -47,10 +45,10 @@ def _weighted(dists, weights, y, x):
     return total
 
 
-@parallel_kernel
+@kernel
 def _boundary_velocity(dists, prev_weights, cur_weights, mask, flow, state):
     height, width = mask.shape
-    for y in prange(height):
+    for y in range(height):
         for x in range(width):
             flow[y, x, 0] = 0.0
             flow[y, x, 1] = 0.0
@@ -226,20 +224,19 @@ def _relax(state, values, row_runs, starts, stops, sweeps, omega):
                             values[y, x] += omega * (total / count - values[y, x])
 
 
-@parallel_kernel
+@kernel
 def _solve_levels(states, shapes, cell_offsets, row_offsets, row_runs, starts, stops, values, fields, sweeps):
-    """The cascadic solve of both channels of ``values`` (H, W, 2), one channel per
-    thread, on the planar work space ``fields`` (2, cells). The levels are packed
+    """The cascadic solve of both channels of ``values`` (H, W, 2), one after the other,
+    on the planar work space ``fields`` (2, cells). The levels are packed
     finest first: level ``l`` has shape ``shapes[l]``, its cells start at
     ``cell_offsets[l]`` and its rows at ``row_offsets[l]`` of ``row_runs``."""
     height, width = values.shape[:2]
-    for y in prange(height):
-        for x in range(width):
-            fields[0, y * width + x] = values[y, x, 0]
-            fields[1, y * width + x] = values[y, x, 1]
     levels = shapes.shape[0]
-    for channel in prange(2):
+    for channel in range(2):
         field = fields[channel]
+        for y in range(height):
+            for x in range(width):
+                field[y * width + x] = values[y, x, channel]
         grids = []
         for level in range(levels):
             cells = slice(cell_offsets[level], cell_offsets[level + 1])
@@ -254,7 +251,7 @@ def _solve_levels(states, shapes, cell_offsets, row_offsets, row_runs, starts, s
             runs = row_runs[row_offsets[level]: row_offsets[level] + shapes[level, 0] + 1]
             level_sweeps = sweeps if level < levels - 1 else _COARSEST_SWEEPS
             _relax(state, level_values, runs, starts, stops, level_sweeps, np.float32(_OMEGA))
-    for y in prange(height):
+    for y in range(height):
         for x in range(width):
             values[y, x, 0] = fields[0, y * width + x]
             values[y, x, 1] = fields[1, y * width + x]
@@ -266,8 +263,7 @@ def _fill_interior(values: np.ndarray, state: np.ndarray, *, sweeps: int) -> Non
     Cascadic multigrid: a full relaxation on the coarsest grid, then on each finer grid
     the prolonged solution is relaxed only near the fixed cells (where the prolongation
     errs); farther away it is already smooth, and ``sweeps`` sweeps would carry a
-    correction only about ``2·sweeps`` cells anyway. The two channels are solved in
-    parallel, each by one thread.
+    correction only about ``2·sweeps`` cells anyway.
     """
     states = [state]
     while max(states[-1].shape) > _COARSEST_SIDE:
@@ -398,13 +394,14 @@ def harmonic_fill(values: np.ndarray, fixed: np.ndarray, domain: np.ndarray, *, 
     return out
 
 
+#: Pixels summed over all slots at a time, so the partial sums stay in cache.
 _SUM_BLOCK = 4096
 
 
-@parallel_kernel
+@kernel
 def _weighted_sum(stack, slot_weights, out):
     count, size = stack.shape
-    for block in prange((size + _SUM_BLOCK - 1) // _SUM_BLOCK):
+    for block in range((size + _SUM_BLOCK - 1) // _SUM_BLOCK):
         start = block * _SUM_BLOCK
         stop = min(start + _SUM_BLOCK, size)
         for i in range(start, stop):
