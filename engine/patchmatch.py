@@ -37,18 +37,24 @@ from fluidymation.engine.random import _key4, _random_below
 from fluidymation.engine.sampling import _bilinear_setup
 
 TILE_ROWS = 16
+PREFETCH_AHEAD = 3
 _CODE = np.uint16
 _CODE_MAX = float(np.iinfo(_CODE).max)
 
 
 @kernel
-def _window_ssd(source_rows, target_rows, run_weights, source_row, source_column, target_row, target_column, size,
-                length, bound):
-    """Weighted SSD of two n×n windows of all features, rows read as contiguous runs of n·F codes."""
+def _window_ssd(source_rows, target_rows, run_weights, source_height, radius, frame, sx, sy, tx, ty, bound):
+    """Weighted SSD of the unrotated n×n windows around source ``(frame, sx, sy)`` and target
+    ``(tx, ty)``, both inside their images; rows are read as contiguous runs of n·F codes."""
+    length = run_weights.shape[0]
+    features = length // (2 * radius + 1)
+    source_row = frame * source_height + sy - radius
+    source_column = (sx - radius) * features
+    target_column = (tx - radius) * features
     total = np.float32(0.0)
-    for dy in range(size):
+    for dy in range(2 * radius + 1):
         source_run = source_rows[source_row + dy, source_column:source_column + length]
-        target_run = target_rows[target_row + dy, target_column:target_column + length]
+        target_run = target_rows[ty - radius + dy, target_column:target_column + length]
         row_total = np.float32(0.0)
         for k in range(length):
             d = np.float32(source_run[k]) - np.float32(target_run[k])
@@ -57,6 +63,20 @@ def _window_ssd(source_rows, target_rows, run_weights, source_row, source_column
         if total > bound:
             return total
     return total
+
+
+@kernel
+def _is_plain_window(plain, source_height, source_width, height, width, radius, tx, ty, x, y, theta):
+    """Whether a candidate's cost is :func:`_window_ssd` (a plain cost, θ = 0, integer
+    position, both windows inside): checked before calling it, which is cheaper than a
+    call of :func:`_patch_cost` with all its arrays."""
+    sx = int(x)
+    sy = int(y)
+    return (
+        plain and theta == 0.0 and x == sx and y == sy
+        and radius <= sx < source_width - radius and radius <= sy < source_height - radius
+        and radius <= tx < width - radius and radius <= ty < height - radius
+    )
 
 
 @kernel
@@ -87,8 +107,7 @@ def _patch_cost(
             and radius <= tx < width - radius and radius <= ty < height - radius
         ):
             return _window_ssd(
-                source_rows, target_rows, run_weights, frame * source_height + sy - radius, (sx - radius) * features,
-                ty - radius, (tx - radius) * features, 2 * radius + 1, (2 * radius + 1) * features, bound,
+                source_rows, target_rows, run_weights, source_height, radius, frame, sx, sy, tx, ty, bound,
             )
         for dy in range(-radius, radius + 1):
             qy = ty + dy
@@ -176,12 +195,23 @@ def _evaluate(
 
 
 @kernel
-def _prefetch_candidate(source_segment, penalty, use_penalty, frame, x, y):
-    """Start loading the label and the penalty of an integer candidate."""
-    pixel = (frame * source_segment.shape[1] + y) * source_segment.shape[2] + x
+def _prefetch_candidate(source_rows, source_segment, penalty, use_penalty, frame, x, y, radius):
+    """Start loading the label, the penalty and the window rows of an integer candidate."""
+    source_height = source_segment.shape[1]
+    source_width = source_segment.shape[2]
+    pixel = (frame * source_height + y) * source_width + x
     prefetch(source_segment, pixel)
     if use_penalty:
         prefetch(penalty, pixel)
+    features = source_rows.shape[1] // source_width
+    first = max(x - radius, 0) * features
+    last = (min(x + radius, source_width - 1) + 1) * features - 1
+    line = 64 // source_rows.itemsize
+    for dy in range(-radius, radius + 1):
+        row = (frame * source_height + min(max(y + dy, 0), source_height - 1)) * source_rows.shape[1]
+        for index in range(row + first, row + last, line):
+            prefetch(source_rows, index)
+        prefetch(source_rows, row + last)
 
 
 @kernel
@@ -209,6 +239,7 @@ def _search(
     while scale * max(source_width, source_height) >= 1.0:
         boxes += 1
         scale *= alpha
+    plain = group_ends.shape[0] == 0 and feature_start == 0 and not use_opposite and orientation_weight == 0.0
     step = -1 if reverse else 1
     tiles = (height + tile_rows - 1) // tile_rows
     for tile in prange(tiles):
@@ -265,12 +296,18 @@ def _search(
                     cand_penalty = _penalty_at(penalty, use_penalty, cand_frame, cx, cy)
                     if cand_penalty >= best_total:
                         continue
-                    cand_error = _patch_cost(
-                        source, target, source_rows, target_rows, feature_weights, run_weights, feature_start,
-                        plain_end, group_ends, weight_maps, opposite_feature, source_angle, target_angle,
-                        orientation_weight, orientation_clamp, use_opposite, radius,
-                        tx, ty, cand_frame, cx, cy, cand_theta, best_total - cand_penalty,
-                    )
+                    bound = best_total - cand_penalty
+                    if _is_plain_window(plain, source_height, source_width, height, width, radius, tx, ty, cx, cy,
+                                        cand_theta):
+                        cand_error = _window_ssd(source_rows, target_rows, run_weights, source_height, radius,
+                                                 cand_frame, int(cx), int(cy), tx, ty, bound)
+                    else:
+                        cand_error = _patch_cost(
+                            source, target, source_rows, target_rows, feature_weights, run_weights, feature_start,
+                            plain_end, group_ends, weight_maps, opposite_feature, source_angle, target_angle,
+                            orientation_weight, orientation_clamp, use_opposite, radius,
+                            tx, ty, cand_frame, cx, cy, cand_theta, bound,
+                        )
                     if cand_error + cand_penalty < best_total:
                         best_frame = cand_frame
                         best_x = cx
@@ -279,8 +316,8 @@ def _search(
                         best_error = cand_error
                         best_total = cand_error + cand_penalty
                 # random search in boxes shrinking by alpha around the match after propagation (as
-                # EbSynth): draw every candidate and start loading its label and penalty (cache
-                # misses), then try the smallest box first
+                # EbSynth): draw every candidate, then try the smallest box first, loading the
+                # data of the candidate PREFETCH_AHEAD places later meanwhile (hides cache misses)
                 key = _key4(seed, salt, ty, tx)
                 centre_x = int(best_x + 0.5)
                 centre_y = int(best_y + 0.5)
@@ -299,10 +336,15 @@ def _search(
                     draws[box, 0] = f_lo + _random_below(key, 3 * box + 2, f_hi - f_lo + 1)
                     draws[box, 1] = x_lo + _random_below(key, 3 * box, x_hi - x_lo + 1)
                     draws[box, 2] = y_lo + _random_below(key, 3 * box + 1, y_hi - y_lo + 1)
-                    _prefetch_candidate(source_segment, penalty, use_penalty, draws[box, 0], draws[box, 1],
-                                        draws[box, 2])
                     scale *= alpha
+                for box in range(boxes - 1, boxes - 1 - min(PREFETCH_AHEAD, boxes), -1):
+                    _prefetch_candidate(source_rows, source_segment, penalty, use_penalty, draws[box, 0],
+                                        draws[box, 1], draws[box, 2], radius)
                 for box in range(boxes - 1, -1, -1):
+                    if box >= PREFETCH_AHEAD:
+                        ahead = box - PREFETCH_AHEAD
+                        _prefetch_candidate(source_rows, source_segment, penalty, use_penalty, draws[ahead, 0],
+                                            draws[ahead, 1], draws[ahead, 2], radius)
                     cand_frame = draws[box, 0]
                     cx_int = draws[box, 1]
                     cy_int = draws[box, 2]
@@ -320,12 +362,18 @@ def _search(
                             cand_theta = np.float32(
                                 _flow_rotation(target_angle, source_angle, cand_frame, cx, cy, tx, ty, flip == 1)
                             )
-                        cand_error = _patch_cost(
-                            source, target, source_rows, target_rows, feature_weights, run_weights, feature_start,
-                            plain_end, group_ends, weight_maps, opposite_feature, source_angle, target_angle,
-                            orientation_weight, orientation_clamp, use_opposite, radius,
-                            tx, ty, cand_frame, cx, cy, cand_theta, best_total - cand_penalty,
-                        )
+                        bound = best_total - cand_penalty
+                        if _is_plain_window(plain, source_height, source_width, height, width, radius, tx, ty, cx, cy,
+                                            cand_theta):
+                            cand_error = _window_ssd(source_rows, target_rows, run_weights, source_height, radius,
+                                                     cand_frame, cx_int, cy_int, tx, ty, bound)
+                        else:
+                            cand_error = _patch_cost(
+                                source, target, source_rows, target_rows, feature_weights, run_weights, feature_start,
+                                plain_end, group_ends, weight_maps, opposite_feature, source_angle, target_angle,
+                                orientation_weight, orientation_clamp, use_opposite, radius,
+                                tx, ty, cand_frame, cx, cy, cand_theta, bound,
+                            )
                         if cand_error + cand_penalty < best_total:
                             best_frame = cand_frame
                             best_x = cx
