@@ -453,8 +453,7 @@ class PatchCost:
     def set_target_colour(self, colour):
         """Store the current target colour (H, W, Cc) float32 into the target features."""
         colours = self.colour_channels
-        _quantize(colour, self.feature_offset[:colours], self.feature_scale[:colours],
-                  self.target_features[:, :, :colours])
+        _quantize(colour, self.feature_offset[:colours], self.feature_scale[:colours], self.target_features, 0)
 
     def kernel_args(self):
         frames, source_height, source_width, features = self.source_features.shape
@@ -538,19 +537,21 @@ def build_patch_cost(*, source_colour, source_guides, target_colour, target_guid
         opposite_feature[colours + position] = colours + position[opposite_guide]
     # ranges span both sides; later votes, averages of source colours, stay inside
     target_colour = np.asarray(target_colour, np.float32)
-    source_features = np.concatenate([source_colour, source_guides], axis=3)
-    target_features = np.concatenate([target_colour, target_guides], axis=2)
-    low = np.minimum(_channel_min(source_features), _channel_min(target_features))
-    high = np.maximum(_channel_max(source_features), _channel_max(target_features))
+    low = np.concatenate([np.minimum(_channel_min(source_colour), _channel_min(target_colour)),
+                          np.minimum(_channel_min(source_guides), _channel_min(target_guides))])
+    high = np.concatenate([np.maximum(_channel_max(source_colour), _channel_max(target_colour)),
+                           np.maximum(_channel_max(source_guides), _channel_max(target_guides))])
     for _ in range(colours + guides):  # features swapped with each other share one range
         low, high = np.minimum(low, low[opposite_feature]), np.maximum(high, high[opposite_feature])
     span = high - low
     scale = np.where(span > 0, _CODE_MAX / np.where(span > 0, span, 1.0), 1.0).astype(np.float32)
     offset = low.astype(np.float32)
-    source_codes = np.empty(source_features.shape, _CODE)
-    _quantize(source_features, offset, scale, source_codes)
-    target_codes = np.empty(target_features.shape, _CODE)
-    _quantize(target_features, offset, scale, target_codes)
+    source_codes = np.empty((frames, source_height, source_width, colours + guides), _CODE)
+    target_codes = np.empty((height, width, colours + guides), _CODE)
+    for values, codes in ((source_colour, source_codes), (target_colour, target_codes)):
+        _quantize(values, offset[:colours], scale[:colours], codes, 0)
+    for values, codes in ((source_guides, source_codes), (target_guides, target_codes)):
+        _quantize(values, offset[colours:], scale[colours:], codes, colours)
     weights = np.concatenate([colour_weights, guide_weights[order]])
     needs_angles = use_opposite or orientation_weight > 0
     if needs_angles and (source_angle is None or target_angle is None):
@@ -594,12 +595,19 @@ def _channel_max(values):
     return values.reshape(-1, values.shape[-1]).max(axis=0, initial=-np.inf).astype(np.float64)
 
 
-def _quantize(values, offset, scale, out):
-    """Store ``round((values − offset) · scale)``, clipped to the code range, into ``out``."""
-    codes = (np.asarray(values, np.float32) - offset) * scale
-    np.rint(codes, out=codes)
-    np.clip(codes, 0.0, _CODE_MAX, out=codes)
-    out[...] = codes
+@parallel_kernel
+def _quantize_rows(values, offset, scale, out, first):
+    for i in prange(values.shape[0]):
+        for c in range(values.shape[1]):
+            code = min(max((values[i, c] - offset[c]) * scale[c], 0.0), _CODE_MAX)
+            out[i, first + c] = int(code + 0.5)
+
+
+def _quantize(values, offset, scale, codes, first):
+    """Store ``round((values − offset) · scale)``, clipped to the code range, into the
+    features ``first, first + 1, …`` of ``codes`` (shape (..., F), C-contiguous)."""
+    values = np.ascontiguousarray(values, np.float32)
+    _quantize_rows(values.reshape(-1, values.shape[-1]), offset, scale, codes.reshape(-1, codes.shape[-1]), first)
 
 
 def patch_errors(cost, nnf):

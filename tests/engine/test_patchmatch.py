@@ -141,3 +141,17 @@ def test_matches_stay_in_their_segment():
     for ty, tx in zip(*np.nonzero(active)):
         x, y, _ = field.coords[ty, tx]
         assert source_segment[field.frame[ty, tx], int(y + 0.5), int(x + 0.5)] == target_segment[ty, tx]
+
+
+def test_window_ssd_matches_naive_cost_inside_both_images():
+    from fluidymation.engine.patchmatch import _window_ssd
+
+    rng = np.random.default_rng(11)
+    cost, source, target, _ = make_cost(rng, source=(9, 10), target=(7, 8))
+    source_rows, target_rows, _, run_weights = cost.kernel_args()[2:6]
+    weights = np.array([1.0, 0.5, 0.25, 2.0, 3.0])
+    for frame, sx, sy, tx, ty in [(0, 2, 2, 2, 2), (1, 7, 6, 5, 4), (1, 4, 3, 3, 2)]:
+        expected = naive_patch_cost(source, target, weights, frame, sx, sy, 0.0, tx, ty, 5)
+        got = _window_ssd(source_rows, target_rows, run_weights, 9, 2, frame, sx, sy, tx, ty, np.float32(np.inf))
+        assert got == pytest.approx(expected, rel=1e-4)
+        assert _window_ssd(source_rows, target_rows, run_weights, 9, 2, frame, sx, sy, tx, ty, np.float32(0.0)) < expected
