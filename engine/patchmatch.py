@@ -3,10 +3,10 @@
 The patch cost of matching target pixel q to source patch ``(i, x, y, θ)`` is a sum over
 the n×n window of
 
-* a weighted SSD of features (colour first, then guides). Features are stored already
-  multiplied by the square root of their weight, so the kernel sums plain squared
-  differences; features may further be scaled per target pixel by a weight map (e.g.
-  the temporal modulation m(q)), evaluated at the window's target pixel;
+* a weighted SSD of features (colour first, then guides). Features are stored as 16-bit
+  codes over each feature's range, the weights scaled to match (see :class:`PatchCost`);
+  features may further be scaled per target pixel by a weight map (e.g. the temporal
+  modulation m(q)), evaluated at the window's target pixel;
 * optionally ``w_dir · min(|tan(S_dir + θ − T_dir)|, clamp)`` (orientation term);
 * optionally, when source and target flows point roughly opposite ways
   (``cos(S_dir(p) + θ − T_dir(q)) < 0`` at the centres), a permutation of the source
@@ -16,6 +16,11 @@ plus, in the search, a per-candidate uniformity penalty looked up in a map over 
 source (:mod:`fluidymation.engine.uniformity`). Summation stops early once the partial
 sum exceeds the current best. A target pixel only matches source patches whose centre
 has the same segment label; pixels labelled -1 are not synthesized.
+
+Speed: the random search is bound by cache misses on its far candidates, so each
+pixel draws all its candidates first (boxes around the match after propagation, as
+EbSynth does) and prefetches their data ``PREFETCH_AHEAD`` candidates before comparing
+them; unrotated integer candidates (plain synthesis) go straight to the row-wise SSD.
 
 Parallelism: the target is cut into fixed bands of rows (tiles), processed in parallel.
 Inside a tile, propagation reads the live field; across a tile border it reads the
@@ -394,9 +399,9 @@ class PatchCost:
 
     Build it with :func:`build_patch_cost`. Features are ordered: colour, guides without
     a weight map, then guides grouped by weight map. They are stored as 16-bit codes
-    ``round((value − offset) · scale)`` per feature, spanning the feature's range (the
-    random search is bound by memory traffic); the cost weighs squared code differences
-    by ``weight / scale²``.
+    ``round((value − offset) · scale)`` per feature, spanning the feature's range (half
+    the cache footprint of float32; the random search is bound by cache misses); the cost
+    weighs squared code differences by ``weight / scale²``.
 
     Attributes
     ----------
