@@ -20,7 +20,7 @@ import tempfile
 
 from fluidymation.errors import SceneError, StageError
 from fluidymation.pipeline import paths
-from fluidymation.pipeline.commands.exemplar import resolve_params
+from fluidymation.pipeline.presets import resolve_params
 from fluidymation.pipeline.resolve import Plan, PlannedLayer
 from fluidymation.stages import exemplar_builtin, exemplar_user, guides, stylize
 
@@ -104,7 +104,7 @@ def layer_source(plan: Plan, layer: PlannedLayer, guide_params: guides.Params, *
 
 def _recording_identity(params: exemplar_user.Params, spec: dict) -> str:
     """A cache key for a recording: its reading options, flow choice and the files' sizes and times."""
-    stamps = [(str(p), p.stat().st_size, p.stat().st_mtime_ns) for p in exemplar_user.sequence_paths(params.source)]
+    stamps = [(str(p), p.stat().st_size, p.stat().st_mtime_ns) for p in exemplar_user.image_sequence(params.source)]
     record = json.dumps({"params": dataclasses.asdict(params), "flow": spec.get("flow", "masks"),
                          "seed": spec.get("seed", 0), "files": stamps}, sort_keys=True, default=str)
     return "recording-" + hashlib.sha256(record.encode()).hexdigest()[:16]

@@ -14,7 +14,6 @@ from importlib import resources
 import yaml
 
 from fluidymation.errors import SceneError, StageError
-from fluidymation.pipeline.commands.guides import guide_params
 from fluidymation.pipeline.resolve import Plan, PlannedLayer
 from fluidymation.stages import guides, stylize
 
@@ -63,9 +62,13 @@ def layer_stylize_params(plan: Plan, layer: PlannedLayer, **overrides) -> styliz
 
 
 def layer_guide_params(plan: Plan, layer: PlannedLayer) -> guides.Params:
-    """Guides parameters of a layer, lengths scaled with the output size."""
+    """Guides parameters of a layer: defaults < layer params of the same names; lengths scaled with the output size."""
     check_layer_params(plan, layer)
-    return guide_params(layer.spec.params, scale=plan.size[0] / plan.source.width, scene=plan.scene.path)
+    chosen = {key: value for key, value in layer.spec.params.items() if key in GUIDE_NAMES}
+    try:
+        return guides.Params(**chosen, scale=plan.size[0] / plan.source.width)
+    except (TypeError, ValueError, StageError) as exc:
+        raise SceneError(f"{plan.scene.path}: layer '{layer.name}' params: {exc}") from None
 
 
 def _counts(plan, layer, key, text):

@@ -12,8 +12,6 @@ and scaled.
 
 from __future__ import annotations
 
-import glob
-import re
 import warnings
 from dataclasses import dataclass
 from pathlib import Path
@@ -23,14 +21,13 @@ from scipy import ndimage
 
 from fluidymation.engine.motion import estimate_motion
 from fluidymation.errors import InputError, StageError
-from fluidymation.stages.files import read_image
+from fluidymation.stages.files import read_image, sequence_paths
 
 NAME = "exemplar_user"
 VERSION = 1
 
 IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".tif", ".tiff", ".bmp", ".webp")
 VIDEO_SUFFIXES = (".mp4", ".mov", ".m4v", ".mkv", ".avi", ".webm", ".gif")
-_PRINTF = re.compile(r"%0?(\d*)d")
 
 
 @dataclass(frozen=True)
@@ -126,26 +123,12 @@ def _selected_indices(count, params):
 # --------------------------------------------------------------------------- reading
 
 
-def sequence_paths(spec: str) -> list[Path]:
-    """Image files of a sequence: a folder, a glob pattern or a printf pattern, in order."""
+def image_sequence(spec: str) -> list[Path]:
+    """Image files of a sequence: a folder (its images), a glob or a printf pattern, in order."""
     path = Path(spec)
     if path.is_dir():
-        files = [p for p in path.iterdir() if p.suffix.lower() in IMAGE_SUFFIXES]
-    elif _PRINTF.search(spec):
-        files = [Path(p) for p in glob.glob(_PRINTF.sub("*", spec)) if _matches_printf(p, spec)]
-    else:
-        files = [Path(p) for p in glob.glob(spec)]
-    return sorted(files, key=_natural_key)
-
-
-def _matches_printf(name, spec):
-    pieces = _PRINTF.split(spec)  # text, width, text, width, ..., text
-    regex = "".join(re.escape(piece) if k % 2 == 0 else r"\d{%d,}" % int(piece or 1) for k, piece in enumerate(pieces))
-    return re.fullmatch(regex, name) is not None
-
-
-def _natural_key(path: Path):
-    return [int(part) if part.isdigit() else part for part in re.split(r"(\d+)", str(path))]
+        return [p for p in sequence_paths(str(path / "*")) if p.suffix.lower() in IMAGE_SUFFIXES]
+    return sequence_paths(spec)
 
 
 def _read_frames(spec: str) -> list[np.ndarray]:
@@ -155,7 +138,7 @@ def _read_frames(spec: str) -> list[np.ndarray]:
     if path.is_file():
         raise InputError(f"{spec}: not a video ({', '.join(VIDEO_SUFFIXES)}) nor an image sequence "
                          "(a folder, a glob like frames/*.png, or a pattern like frames/%04d.png)")
-    files = sequence_paths(spec)
+    files = image_sequence(spec)
     if not files:
         raise InputError(f"{spec}: no such video and no images match it as a sequence "
                          "(a folder, a glob like frames/*.png, or a pattern like frames/%04d.png)")
@@ -182,7 +165,7 @@ def _read_video(path: Path) -> list[np.ndarray]:
 
 
 def _read_masks(spec, count, shape, source) -> np.ndarray:
-    files = sequence_paths(spec)
+    files = image_sequence(spec)
     if not files:
         raise InputError(f"{spec}: no mask images found (a folder, a glob or a %04d pattern, or `auto`)")
     if len(files) != count:

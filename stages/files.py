@@ -7,7 +7,9 @@ renamed into place, so a killed render never leaves a partial file under a final
 from __future__ import annotations
 
 import contextlib
+import glob
 import os
+import re
 import tempfile
 from pathlib import Path
 
@@ -15,6 +17,30 @@ import imageio.v3 as iio
 import numpy as np
 
 from fluidymation.errors import InputError
+
+
+_PRINTF = re.compile(r"%0?(\d*)d")
+
+
+def is_sequence_pattern(text: str) -> bool:
+    """Whether ``text`` names several files: a printf number (``%04d``) or glob characters."""
+    return bool(_PRINTF.search(text)) or any(char in text for char in "*?[")
+
+
+def sequence_paths(spec: str) -> list[Path]:
+    """Files matching a printf pattern (``frames/%04d.png``) or a glob, in natural number order."""
+    if _PRINTF.search(spec):
+        pieces = _PRINTF.split(spec)  # text, width, text, width, ..., text
+        regex = "".join(re.escape(piece) if k % 2 == 0 else r"\d{%d,}" % int(piece or 1)
+                        for k, piece in enumerate(pieces))
+        files = [Path(p) for p in glob.glob(_PRINTF.sub("*", spec)) if re.fullmatch(regex, p)]
+    else:
+        files = [Path(p) for p in glob.glob(spec)]
+    return sorted(files, key=_natural_key)
+
+
+def _natural_key(path: Path):
+    return [int(part) if part.isdigit() else part for part in re.split(r"(\d+)", str(path))]
 
 
 @contextlib.contextmanager

@@ -13,20 +13,16 @@ from __future__ import annotations
 import dataclasses
 import json
 import os
-import re
-from importlib import resources
 from pathlib import Path
 
 import numpy as np
-import yaml
 from scipy import ndimage
 
 from fluidymation.errors import InputError
+from fluidymation.pipeline.presets import parse_size, preset_defaults, resolve_params
 from fluidymation.pipeline.progress import progress
 from fluidymation.stages import exemplar_builtin
 from fluidymation.stages.files import read_image, write_npy, write_png, write_text
-
-_SIZE = re.compile(r"^(\d+)[xX](\d+)$")
 
 
 def add_parser(subparsers) -> None:
@@ -55,61 +51,6 @@ def add_parser(subparsers) -> None:
     show.add_argument("-o", "--output", metavar="SHEET.png", required=True, help="the contact sheet to write")
     show.add_argument("--count", type=int, default=6, metavar="N", help="frames shown, evenly spaced (default 6)")
     show.set_defaults(run=run_show)
-
-
-def preset_defaults() -> dict:
-    """Default parameters of every built-in preset, by name, from ``configs/exemplars.yaml``."""
-    text = resources.files("fluidymation.configs").joinpath("exemplars.yaml").read_text(encoding="utf-8")
-    return yaml.safe_load(text)["presets"]
-
-
-def resolve_params(name: str, *, seed=None, size=None, frames=None, color=None, wetness=None) -> exemplar_builtin.Params:
-    """The preset's defaults overridden by the given values (``None`` keeps the default).
-
-    ``size`` is (width, height). Raises :class:`InputError` for an unknown name.
-    """
-    defaults = preset_defaults()
-    if name not in defaults or name not in exemplar_builtin.PRESETS:
-        valid = ", ".join(sorted(set(defaults) & set(exemplar_builtin.PRESETS)))
-        raise InputError(f"unknown built-in exemplar {name!r}; valid names: {valid}")
-    chosen = dict(defaults[name])
-    for key, value in (("seed", seed), ("size", size), ("frames", frames), ("color", color), ("wetness", wetness)):
-        if value is not None:
-            chosen[key] = value
-    if isinstance(chosen["size"], str):
-        chosen["size"] = parse_size([chosen["size"]])
-    try:
-        width, height = chosen["size"]
-        return exemplar_builtin.Params(
-            preset=name,
-            seed=_whole(chosen["seed"], "seed"),
-            size=(_whole(width, "size"), _whole(height, "size")),
-            frames=_whole(chosen["frames"], "frames"),
-            color=str(chosen["color"]).lower(),
-            wetness=float(chosen["wetness"]),
-        )
-    except (TypeError, ValueError):
-        raise InputError(f"built-in exemplar {name!r}: expected seed and frames as whole numbers, size as "
-                         f"[width, height], wetness as a number; got {chosen}") from None
-
-
-def _whole(value, key):
-    if isinstance(value, bool) or int(value) != value:
-        raise ValueError(f"{key} must be a whole number")
-    return int(value)
-
-
-def parse_size(tokens) -> tuple[int, int] | None:
-    """``["W", "H"]`` or ``["WxH"]`` to (width, height); ``None`` stays ``None``."""
-    if tokens is None:
-        return None
-    if len(tokens) == 1 and _SIZE.match(tokens[0]):
-        width, height = _SIZE.match(tokens[0]).groups()
-    elif len(tokens) == 2 and all(token.isdigit() for token in tokens):
-        width, height = tokens
-    else:
-        raise InputError(f"--size: expected `W H` or `WxH` (e.g. 256 256 or 256x256), got {' '.join(tokens)!r}")
-    return int(width), int(height)
 
 
 def default_cache_dir() -> Path:

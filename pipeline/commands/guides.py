@@ -2,14 +2,13 @@
 
 from __future__ import annotations
 
-import dataclasses
 from pathlib import Path
 
-from fluidymation.errors import InputError, SceneError, StageError
-from fluidymation.pipeline.progress import progress
-from fluidymation.pipeline.resolve import parse_window, plan_scene
+from fluidymation.errors import InputError
+from fluidymation.pipeline.parameters import layer_guide_params
+from fluidymation.pipeline.progress import progress, reporter
+from fluidymation.pipeline.resolve import Plan, PlannedLayer, parse_window, plan_scene
 from fluidymation.pipeline.scene import load_scene
-from fluidymation.stages import guides
 from fluidymation.stages.guide_views import write_guide_views
 from fluidymation.stages.rasterize import Params as RasterParams
 from fluidymation.stages.rasterize import rasterize_frame
@@ -39,33 +38,24 @@ def run(args) -> int:
     window = plan.frames(parse_window(args.frames))
     out_dir = Path(args.output) if args.output else plan.scene.output.dir / "guides" / layer.dirname
     raster = RasterParams(size=plan.size, fps=plan.fps)
-    params = guide_params(layer.spec.params, scale=plan.size[0] / plan.source.width, scene=plan.scene.path)
     given = given_flows(args.flow, plan.frame_count) if args.flow else None
 
-    def mask(index: int):
+    def coverage(index: int):
         return rasterize_frame(plan.source, layer.vector_layers, plan.start + index, raster).coverage
 
-    with progress(1, f"guides {layer.name}", quiet=args.quiet, unit="step") as bar:
-        def report(done: int, total: int) -> None:
-            bar.total = total
-            bar.n = done
-            bar.refresh()
-
-        write_guide_views(mask, plan.frame_count, out_dir, params=params, raw=args.raw, given_flow=given,
-                          frames=(window.start - plan.start, window.stop - plan.start), progress=report)
+    write_layer_guides(plan, layer, window, coverage, out_dir, quiet=args.quiet, raw=args.raw, given_flow=given)
     if not args.quiet:
         print(f"wrote guide views of frames {window.start}:{window.stop} of layer {layer.name} to {out_dir}")
     return 0
 
 
-def guide_params(layer_params: dict, *, scale: float, scene: Path) -> guides.Params:
-    """The guides stage's parameters: defaults, overridden by the layer's ``params`` of the same names."""
-    names = {field.name for field in dataclasses.fields(guides.Params)} - {"scale"}
-    chosen = {key: value for key, value in layer_params.items() if key in names}
-    try:
-        return guides.Params(**chosen, scale=scale)
-    except (TypeError, ValueError, StageError) as exc:
-        raise SceneError(f"{scene}: layer params: {exc}") from None
+def write_layer_guides(plan: Plan, layer: PlannedLayer, window: range, coverage, out_dir: Path, *, quiet=False,
+                       raw=False, given_flow=None) -> None:
+    """Guides of ``layer`` over the scene range (masks from ``coverage(index)``), views of ``window`` to ``out_dir``."""
+    with progress(1, f"guides {layer.name}", quiet=quiet, unit="step") as bar:
+        write_guide_views(coverage, plan.frame_count, out_dir, params=layer_guide_params(plan, layer), raw=raw,
+                          given_flow=given_flow, frames=(window.start - plan.start, window.stop - plan.start),
+                          progress=reporter(bar))
 
 
 def given_flows(pattern: str, count: int) -> list[Path]:

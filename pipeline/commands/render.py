@@ -14,13 +14,13 @@ from pathlib import Path
 import numpy as np
 
 from fluidymation.errors import InputError
+from fluidymation.pipeline.commands.guides import write_layer_guides
 from fluidymation.pipeline.exemplars import layer_source, simulated_frame_count
 from fluidymation.pipeline.parameters import check_layer_params, layer_guide_params, layer_stylize_params
 from fluidymation.pipeline.progress import progress
 from fluidymation.pipeline.resolve import parse_window, plan_scene
 from fluidymation.pipeline.scene import load_scene
 from fluidymation.stages.files import write_npy, write_png
-from fluidymation.stages.guide_views import write_guide_views
 from fluidymation.stages.rasterize import Params as RasterParams
 from fluidymation.stages.rasterize import rasterize_frame
 from fluidymation.stages.stylize import stylize_sequence
@@ -71,25 +71,13 @@ def run(args) -> int:
                           (coverage(frame - plan.start) > 0.5).astype(np.uint8) * 255)
                 bar.update()
         if args.until == "guides":
-            _write_guides(plan, layer, window, coverage, args.quiet)
+            write_layer_guides(plan, layer, window, coverage, out_dir / "guides" / layer.dirname, quiet=args.quiet)
         elif args.until == "stylize":
             _stylize(plan, layer, window, coverage, args)
     if not args.quiet:
         print(f"rendered {len(layers)} layer(s), frames {window.start}:{window.stop}, up to {args.until}, "
               f"into {out_dir}")
     return 0
-
-
-def _write_guides(plan, layer, window, coverage, quiet):
-    with progress(1, f"guides {layer.name}", quiet=quiet, unit="step") as bar:
-        def report(done, total):
-            bar.total = total
-            bar.n = done
-            bar.refresh()
-
-        write_guide_views(coverage, plan.frame_count, plan.scene.output.dir / "guides" / layer.dirname,
-                          params=layer_guide_params(plan, layer), progress=report,
-                          frames=(window.start - plan.start, window.stop - plan.start))
 
 
 def stylize_layer(plan, layer, window, coverage, out_dir: Path, *, quiet=False, nnf=False, **overrides):

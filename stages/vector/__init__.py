@@ -9,13 +9,13 @@ from __future__ import annotations
 from pathlib import Path
 
 from fluidymation.errors import InputError
+from fluidymation.stages.files import is_sequence_pattern
 from fluidymation.stages.vector.base import DEFAULT_FPS, VectorLayer, VectorSource
 from fluidymation.stages.vector.lottie_input import open_lottie, open_smil_svg
 from fluidymation.stages.vector.svg_input import (
     SvgSequenceSource,
     SvgSource,
     has_smil,
-    is_sequence_pattern,
     load_svg,
     sequence_files,
 )

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from abc import ABC, abstractmethod
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -19,7 +20,7 @@ class VectorLayer:
     z: int
 
 
-class VectorSource:
+class VectorSource(ABC):
     """A vector animation: named layers that can be rendered alone at any frame and size.
 
     Subclasses set ``path``, ``width``, ``height`` (native size, px), ``native_fps``
@@ -34,16 +35,16 @@ class VectorSource:
     native_fps: float | None
     layers: list[VectorLayer]
 
+    @abstractmethod
     def default_range(self, fps: float) -> tuple[int, int]:
         """The animation's own frames at ``fps``: (first, end exclusive)."""
-        raise NotImplementedError
 
+    @abstractmethod
     def render(self, names: list[str], frame: int, fps: float, size: tuple[int, int]) -> np.ndarray:
         """Render only the layers ``names`` at scene ``frame`` (at ``fps``), size (W, H).
 
         Returns (H, W, 4) uint8 premultiplied RGBA.
         """
-        raise NotImplementedError
 
     def layer_names(self) -> list[str]:
         return [layer.name for layer in self.layers]

@@ -8,12 +8,12 @@ alone, every other top-level drawable element is given ``display="none"``.
 from __future__ import annotations
 
 import copy
-import glob
 import re
 from pathlib import Path
 from xml.etree import ElementTree
 
 from fluidymation.errors import InputError
+from fluidymation.stages.files import sequence_paths
 from fluidymation.stages.vector.base import VectorLayer, VectorSource
 from fluidymation.stages.vector.raster import render_svg
 from fluidymation.stages.vector.safety import check_svg_references, local_name, parse_xml, read_file
@@ -136,27 +136,11 @@ class SvgSequenceSource(VectorSource):
         return render_svg(_isolated_svg(load_svg(path), names), size, str(path))
 
 
-def is_sequence_pattern(text: str) -> bool:
-    return bool(re.search(r"%0?\d*d", text)) or any(char in text for char in "*?[")
-
-
 def sequence_files(pattern: Path) -> list[Path]:
-    """Files of a ``frames/%04d.svg`` or glob pattern, in frame order."""
-    text = str(pattern)
-    printf = re.search(r"%(0?\d*)d", text)
-    if printf:
-        regex = re.compile(re.escape(text[: printf.start()]) + r"(\d+)" + re.escape(text[printf.end():]) + "$")
-        candidates = glob.glob(text[: printf.start()] + "*" + text[printf.end():])
-        numbered = sorted((int(m.group(1)), p) for p in candidates if (m := regex.match(p)))
-        files = [Path(p) for _, p in numbered]
-    else:
-        files = sorted((Path(p) for p in glob.glob(text)), key=_natural_key)
+    """Files of a ``frames/%04d.svg`` or glob pattern, in frame order; an InputError when none or too many."""
+    files = sequence_paths(str(pattern))
     if not files:
         raise InputError(f"{pattern}: no files match this sequence pattern")
     if len(files) > MAX_SEQUENCE_FILES:
         raise InputError(f"{pattern}: {len(files)} files is over the limit of {MAX_SEQUENCE_FILES} frames")
     return files
-
-
-def _natural_key(path: Path):
-    return [int(part) if part.isdigit() else part for part in re.split(r"(\d+)", str(path))]

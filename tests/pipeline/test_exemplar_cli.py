@@ -73,7 +73,7 @@ def test_show_without_frames_is_an_input_error(cli, tmp_path):
 
 def test_resolve_params_takes_defaults_and_checks_types():
     from fluidymation.errors import InputError
-    from fluidymation.pipeline.commands.exemplar import resolve_params
+    from fluidymation.pipeline.presets import resolve_params
 
     params = resolve_params("crumble", size="64x32", seed=7)
     assert params.size == (64, 32) and params.seed == 7 and params.frames == 60 and params.color == "#2b2b2b"

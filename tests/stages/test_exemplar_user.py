@@ -65,7 +65,7 @@ def test_given_masks_with_range_step_reverse_and_scale(tmp_path):
 def test_natural_order_of_unpadded_numbers(tmp_path):
     frames, _ = _frames(count=11)
     _write_sequence(tmp_path / "frames", frames, "{}.png")
-    paths = eu.sequence_paths(str(tmp_path / "frames"))
+    paths = eu.image_sequence(str(tmp_path / "frames"))
     assert [p.stem for p in paths] == [str(k) for k in range(11)]
 
 

@@ -1,6 +1,5 @@
 """Vector inputs: exact geometry, and agreement with the lottie package's own rendering."""
 
-import copy
 import io
 import json
 from pathlib import Path
