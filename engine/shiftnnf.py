@@ -40,24 +40,18 @@ def _shift(frame_in, coords_in, target_motion, target_angle, source_ext_plus, so
             best_frame = frame
             best_gap = abs(wanted)
             best_amount = 0.0
-            if opposite:
-                start = source_ext_minus[frame, sy, sx]
-                for candidate in range(frame - 1, -1, -1):
-                    amount = source_ext_minus[candidate, sy, sx] - start
-                    gap = abs(wanted - amount)
-                    if gap < best_gap:
-                        best_gap = gap
-                        best_frame = candidate
-                        best_amount = amount
-            else:
-                start = source_ext_plus[frame, sy, sx]
-                for candidate in range(frame + 1, frames):
-                    amount = source_ext_plus[candidate, sy, sx] - start
-                    gap = abs(wanted - amount)
-                    if gap < best_gap:
-                        best_gap = gap
-                        best_frame = candidate
-                        best_amount = amount
+            # forward along ext+, or backward along ext− where the flows are opposite
+            extent = source_ext_minus if opposite else source_ext_plus
+            step = -1 if opposite else 1
+            stop = -1 if opposite else frames
+            start = extent[frame, sy, sx]
+            for candidate in range(frame + step, stop, step):
+                amount = extent[candidate, sy, sx] - start
+                gap = abs(wanted - amount)
+                if gap < best_gap:
+                    best_gap = gap
+                    best_frame = candidate
+                    best_amount = amount
             frame_out[ty, tx] = best_frame
             achieved[ty, tx] = best_amount
 
