@@ -40,3 +40,16 @@ def test_guides_bad_layer_param(cli, tmp_path):
     (tmp_path / "f00.svg").write_text('<svg xmlns="http://www.w3.org/2000/svg" width="8" height="8"><g id="disk"/></svg>')
     code, _, err = cli("guides", scene, "--layer", "disk")
     assert code == 2 and "scene.yaml" in err and "blur_sigma" in err
+
+
+def test_given_flows_replace_the_estimate(cli, tmp_path):
+    scene = moving_disk_scene(tmp_path, frames=4)
+    (tmp_path / "flows").mkdir()
+    for index in range(4):
+        np.save(tmp_path / "flows" / f"{index:03d}.npy", np.full((48, 64, 2), (0.5, -1.5), np.float32))
+    code, _, err = cli("-q", "guides", scene, "--layer", "disk", "--raw", "-o", tmp_path / "g",
+                       "--flow", tmp_path / "flows" / "%03d.npy")
+    assert code == 0, err
+    assert np.array_equal(np.load(tmp_path / "g" / "flow" / "00002.npy"), np.full((48, 64, 2), (0.5, -1.5), np.float32))
+    code, _, err = cli("guides", scene, "--layer", "disk", "--flow", tmp_path / "none" / "%03d.npy")
+    assert code == 2 and "no files match" in err
