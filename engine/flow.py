@@ -2,13 +2,24 @@
 
 On the inner boundary of a mask the material moves along the distance gradient by the
 change of the signed distance between two frames; with ``dist`` positive inside the
-gradient points inward, hence the minus sign: ``flow = -(dist_cur - dist_prev) ·
-∇dist_cur / |∇dist_cur|``, so the flow points outward where a mask grows. The rest of
-the image is filled by solving Laplace's equation with those boundary values (cascadic
-multigrid: solve on the coarsest grid, then prolong and relax level by level). Inside
-the mask that is the harmonic interpolation of the boundary; outside it is a smooth
-extension, so that smoothing flows along time near a moving boundary blends like with
-like instead of with zeros.
+gradient points inward, hence the minus sign: the normal velocity is ``-(dist_cur -
+dist_prev) · ∇dist_cur / |∇dist_cur|``, so the flow points outward where a mask grows.
+
+Masks show only that normal component. Filling it alone into the interior under-reads
+rigid motion: a disk translating at v has normal boundary velocity ``v·cos φ`` along
+its normal, whose harmonic fill reads v/2 at the centre. So per connected component
+the normal velocities are also fitted (least squares, slightly regularised) by an
+affine motion ``u(x) = b + A·(x − c)``, and each boundary pixel gets that motion's
+tangential part, scaled by the share of the normal velocities' energy the fit explains
+(1 for a rigid or affine motion, near 0 for a deformation it cannot express), plus the
+measured normal part. Affine fields are harmonic, so a translating, rotating or scaling
+shape's interior reads its motion exactly.
+
+The rest of the image is filled by solving Laplace's equation with those boundary
+values (cascadic multigrid: solve on the coarsest grid, then prolong and relax level by
+level). Inside the mask that is the harmonic interpolation of the boundary; outside it
+is a smooth extension, so that smoothing flows along time near a moving boundary blends
+like with like instead of with zeros.
 
 Flows are float32 ``(H, W, 2)`` holding ``(dx, dy)`` in px/frame with y pointing down.
 """
@@ -18,6 +29,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from scipy import ndimage
+
 from fluidymation.engine._jit import kernel
 
 _OUTSIDE = 0
@@ -33,6 +46,11 @@ _OMEGA = 1.6
 _TILE = 8
 #: Distance changes at or below this (px) are float rounding of the temporal filter.
 _STILL = 1e-4
+#: Ridge added to the affine fit's normal equations, per boundary pixel: on the
+#: translation and on the linear part (coordinates in units of the component's radius).
+#: Motions the boundary does not show (a circle's rotation) stay near zero.
+_RIDGE_TRANSLATION = 0.01
+_RIDGE_LINEAR = 0.1
 
 
 @kernel
@@ -46,12 +64,15 @@ def _weighted(dists, weights, y, x):
 
 
 @kernel
-def _boundary_velocity(dists, prev_weights, cur_weights, mask, flow, state):
+def _boundary_velocity(dists, prev_weights, cur_weights, mask, normal, speed, state):
+    """Mark the inner boundary fixed; store there the unit inward normal ∇D/|∇D| (zero
+    where the gradient vanishes) and the speed along it, ``-ΔD/|∇D|``."""
     height, width = mask.shape
     for y in range(height):
         for x in range(width):
-            flow[y, x, 0] = 0.0
-            flow[y, x, 1] = 0.0
+            normal[y, x, 0] = 0.0
+            normal[y, x, 1] = 0.0
+            speed[y, x] = 0.0
             if not mask[y, x]:
                 state[y, x] = _UNKNOWN
                 continue
@@ -74,12 +95,112 @@ def _boundary_velocity(dists, prev_weights, cur_weights, mask, flow, state):
             norm = math.sqrt(grad_x * grad_x + grad_y * grad_y)
             if norm < 1e-6:
                 continue
+            normal[y, x, 0] = grad_x / norm
+            normal[y, x, 1] = grad_y / norm
             change = _weighted(dists, cur_weights, y, x) - _weighted(dists, prev_weights, y, x)
-            if abs(change) <= _STILL:
+            if abs(change) > _STILL:
+                speed[y, x] = -change / norm
+
+
+@kernel
+def _affine_features(normal, x, y, centre_x, centre_y, radius, features):
+    """``features · p`` is the normal component of the affine motion ``p`` at (x, y):
+    ``p = (b_x, b_y, a_xx, a_xy, a_yx, a_yy)``, ``u = b + A·((x, y) − c)/radius``."""
+    gx = normal[y, x, 0]
+    gy = normal[y, x, 1]
+    rx = (x - centre_x) / radius
+    ry = (y - centre_y) / radius
+    features[0] = gx
+    features[1] = gy
+    features[2] = gx * rx
+    features[3] = gx * ry
+    features[4] = gy * rx
+    features[5] = gy * ry
+
+
+@kernel
+def _affine_normal_equations(normal, speed, state, labels, geometry, matrices, rhs, energy):
+    """Per component (label ≥ 1): ``geometry[l] = (centre x, centre y, radius, pixels)``
+    of its boundary, and the normal equations of the affine fit to its normal speeds."""
+    height, width = state.shape
+    geometry[...] = 0.0
+    for y in range(height):
+        for x in range(width):
+            if state[y, x] == _FIXED and labels[y, x] > 0:
+                label = labels[y, x]
+                geometry[label, 0] += x
+                geometry[label, 1] += y
+                geometry[label, 3] += 1.0
+    for label in range(geometry.shape[0]):
+        if geometry[label, 3] > 0.0:
+            geometry[label, 0] /= geometry[label, 3]
+            geometry[label, 1] /= geometry[label, 3]
+    for y in range(height):
+        for x in range(width):
+            if state[y, x] == _FIXED and labels[y, x] > 0:
+                label = labels[y, x]
+                geometry[label, 2] += (x - geometry[label, 0]) ** 2 + (y - geometry[label, 1]) ** 2
+    for label in range(geometry.shape[0]):
+        if geometry[label, 3] > 0.0:
+            geometry[label, 2] = max(math.sqrt(geometry[label, 2] / geometry[label, 3]), 1.0)
+    matrices[...] = 0.0
+    rhs[...] = 0.0
+    energy[...] = 0.0
+    features = np.empty(6, dtype=np.float64)
+    for y in range(height):
+        for x in range(width):
+            if state[y, x] != _FIXED or labels[y, x] <= 0:
                 continue
-            speed = -change / norm
-            flow[y, x, 0] = speed * grad_x
-            flow[y, x, 1] = speed * grad_y
+            label = labels[y, x]
+            _affine_features(normal, x, y, geometry[label, 0], geometry[label, 1], geometry[label, 2], features)
+            for row in range(6):
+                rhs[label, row] += features[row] * speed[y, x]
+                for column in range(6):
+                    matrices[label, row, column] += features[row] * features[column]
+            energy[label] += speed[y, x] * speed[y, x]
+
+
+@kernel
+def _boundary_values(normal, speed, state, labels, geometry, motions, flow):
+    """``flow`` on the boundary: the fitted motion with its normal part replaced by the
+    measured one; zero elsewhere."""
+    height, width = state.shape
+    for y in range(height):
+        for x in range(width):
+            flow[y, x, 0] = 0.0
+            flow[y, x, 1] = 0.0
+            if state[y, x] != _FIXED:
+                continue
+            label = labels[y, x]
+            gx = normal[y, x, 0]
+            gy = normal[y, x, 1]
+            rx = (x - geometry[label, 0]) / geometry[label, 2]
+            ry = (y - geometry[label, 1]) / geometry[label, 2]
+            p = motions[label]
+            u_x = p[0] + p[2] * rx + p[3] * ry
+            u_y = p[1] + p[4] * rx + p[5] * ry
+            along = speed[y, x] - (gx * u_x + gy * u_y)
+            flow[y, x, 0] = u_x + along * gx
+            flow[y, x, 1] = u_y + along * gy
+
+
+def _fit_affine_motions(normal, speed, state, mask):
+    """Component labels, boundary geometry and per component the affine motion
+    parameters, already scaled by the share of the normal speeds' energy they explain."""
+    labels, count = ndimage.label(mask)
+    labels = labels.astype(np.int32)
+    geometry = np.empty((count + 1, 4), dtype=np.float64)
+    matrices = np.empty((count + 1, 6, 6), dtype=np.float64)
+    rhs = np.empty((count + 1, 6), dtype=np.float64)
+    energy = np.empty(count + 1, dtype=np.float64)
+    _affine_normal_equations(normal, speed, state, labels, geometry, matrices, rhs, energy)
+    ridge = np.diag([_RIDGE_TRANSLATION] * 2 + [_RIDGE_LINEAR] * 4)
+    pixels = np.maximum(geometry[:, 3], 1.0)
+    motions = np.linalg.solve(matrices + pixels[:, None, None] * ridge, rhs[:, :, None])[:, :, 0]
+    residual = energy - 2 * np.einsum("li,li->l", motions, rhs) + np.einsum("li,lij,lj->l", motions, matrices, motions)
+    explained = np.where(energy > 0, 1.0 - residual / np.maximum(energy, 1e-30), 0.0)
+    motions *= np.clip(explained, 0.0, 1.0)[:, None]
+    return labels, geometry, motions
 
 
 @kernel
@@ -315,8 +436,10 @@ def flow_from_distances(
         be smoothed along time.
     mask : (H, W) bool
         The mask whose inner boundary carries the estimate (pixels inside with a
-        4-neighbour outside); every other pixel gets the harmonic interpolation of the
-        boundary values (zero normal derivative at the image edges).
+        4-neighbour outside): the measured normal velocity plus the tangential part of
+        the affine motion fitted to its connected component (see the module notes);
+        every other pixel gets the harmonic interpolation of the boundary values (zero
+        normal derivative at the image edges).
     sweeps : int
         Red-black relaxation sweeps per multigrid level.
 
@@ -361,9 +484,13 @@ def flow_from_distance_stack(
         )
     if sweeps < 1:
         raise ValueError(f"sweeps must be at least 1, got {sweeps}")
-    flow = np.empty(mask.shape + (2,), dtype=np.float32)
+    normal = np.empty(mask.shape + (2,), dtype=np.float32)
+    speed = np.empty(mask.shape, dtype=np.float32)
     state = np.empty(mask.shape, dtype=np.int8)
-    _boundary_velocity(dists, prev_weights, cur_weights, mask, flow, state)
+    _boundary_velocity(dists, prev_weights, cur_weights, mask, normal, speed, state)
+    labels, geometry, motions = _fit_affine_motions(normal, speed, state, mask)
+    flow = np.empty(mask.shape + (2,), dtype=np.float32)
+    _boundary_values(normal, speed, state, labels, geometry, motions, flow)
     _fill_interior(flow, state, sweeps=sweeps)
     return flow
 

@@ -43,6 +43,30 @@ def test_translating_disk_boundary_flow_points_along_the_motion():
     np.testing.assert_allclose(speed, np.abs(normals[lead_trail] @ velocity), rtol=0.05)
 
 
+def test_translating_shapes_interior_moves_with_the_shape():
+    # the normal boundary motion alone, filled harmonically, reads a disk's centre at
+    # half the speed; the fitted motion's tangential part makes it the full velocity
+    velocity = np.array([1.5, -0.75])
+    centre = np.array([35.3, 36.1])
+    square = np.maximum(np.abs(XX - centre[0]), np.abs(YY - centre[1]))
+    before = np.maximum(np.abs(XX - centre[0] + velocity[0]), np.abs(YY - centre[1] + velocity[1]))
+    for dist_prev, dist_cur in ((_disk_distance(*(centre - velocity), 20.0), _disk_distance(*centre, 20.0)),
+                                ((18.0 - before).astype(np.float32), (18.0 - square).astype(np.float32))):
+        result = flow.flow_from_distances(dist_prev, dist_cur, dist_cur > 0)
+        error = np.linalg.norm(result - velocity, axis=2)[dist_cur > 2] / np.linalg.norm(velocity)
+        assert error.mean() < 0.05 and np.percentile(error, 95) < 0.1  # the square's corners err most
+
+
+def test_two_shapes_moving_apart_each_keep_their_own_motion():
+    left, right = np.array([-1.0, 0.0]), np.array([0.5, 1.0])
+    dist_prev = np.maximum(_disk_distance(18 - left[0], 36 - left[1], 12.0), _disk_distance(52 - right[0], 36 - right[1], 12.0))
+    dist_cur = np.maximum(_disk_distance(18, 36, 12.0), _disk_distance(52, 36, 12.0))
+    result = flow.flow_from_distances(dist_prev, dist_cur, dist_cur > 0)
+    for velocity, cx in ((left, 18), (right, 52)):
+        inside = np.hypot(XX - cx, YY - 36) < 10
+        assert np.abs(result[inside] - velocity).max() < 0.1 * np.linalg.norm(velocity) + 0.02
+
+
 def test_growing_disk_flow_points_outward_and_interior_is_harmonic():
     growth = 1.25
     result = flow.flow_from_distances(_disk_distance(36, 36, 24.0 - growth), _disk_distance(36, 36, 24.0), _disk_distance(36, 36, 24.0) > 0)
