@@ -188,12 +188,19 @@ class GuideCache:
 
 class _Window:
     """A per-frame quantity produced in increasing frame order and kept in a ring of
-    ``depth`` frames; indices outside the sequence are clamped to its ends."""
+    ``depth`` frames.
 
-    def __init__(self, frame_count: int, depth: int, produce: Callable[[int], np.ndarray]):
+    Temporal filters read frames beyond the sequence's ends as clamped to the end frame
+    (``extrapolate=False``: constant) or linearly extrapolated by odd reflection about
+    it (``extrapolate=True``: ``f(−k) = 2·f(0) − f(k)``, likewise after the last frame),
+    which keeps a steady motion steady up to the ends.
+    """
+
+    def __init__(self, frame_count: int, depth: int, produce: Callable[[int], np.ndarray], *, extrapolate: bool):
         self.frame_count = frame_count
         self.depth = depth
         self.produce = produce
+        self.extrapolate = extrapolate
         self.ring: np.ndarray | None = None
         self.produced = 0
 
@@ -213,20 +220,27 @@ class _Window:
             raise RuntimeError(f"frame {index} already left the window (depth {self.depth})")
         return self.ring[index % self.depth]
 
+    def _terms(self, index: int) -> list[tuple[int, float]]:
+        """Frame ``index`` as ``(frame, factor)`` terms of frames inside the sequence."""
+        end = self._clamp(index)
+        if end == index or not self.extrapolate:
+            return [(end, 1.0)]
+        return [(end, 2.0), (self._clamp(2 * end - index), -1.0)]
+
     def slot_weights(self, center: int, taps: np.ndarray) -> np.ndarray:
         """Weights of the ring's slots that make ``sum_k taps[k] · frame[center + k − r]``
-        (frame indices clamped); valid until the ring moves on."""
+        (frames beyond the ends as the window reads them); valid until the ring moves on."""
         radius = taps.shape[0] // 2
         self.get(center + radius)
         weights = np.zeros(self.depth, dtype=np.float32)
         for offset in range(-radius, radius + 1):
-            index = self._clamp(center + offset)
-            self.get(index)
-            weights[index % self.depth] += taps[offset + radius]
+            for index, factor in self._terms(center + offset):
+                self.get(index)
+                weights[index % self.depth] += factor * taps[offset + radius]
         return weights
 
     def smoothed(self, center: int, taps: np.ndarray) -> np.ndarray:
-        """``sum_k taps[k] · frame[center + k − r]`` with clamped frame indices."""
+        """``sum_k taps[k] · frame[center + k − r]``, frames beyond the ends as the window reads them."""
         weights = self.slot_weights(center, taps)
         return flow_kernels.weighted_sum(self.ring, weights)
 
@@ -317,7 +331,9 @@ def compute_guides(
         blurred = distance.gaussian_blur(coverage, sigma=params.blur_sigma * scale)
         return distance.signed_distance(blurred, threshold=params.threshold)
 
-    dists = _Window(frame_count, 2 * dist_radius + flow_radius + 3, produce_dist)
+    # distances extrapolated linearly past the ends, so the ends' motion is not damped;
+    # flows held constant past the ends (a steady motion again)
+    dists = _Window(frame_count, 2 * dist_radius + flow_radius + 3, produce_dist, extrapolate=True)
 
     def produce_raw_flow(index: int) -> np.ndarray:
         mask = dists.get(index) > 0
@@ -333,7 +349,7 @@ def compute_guides(
         )
         return -motion if index == 0 else motion
 
-    raw_flows = _Window(frame_count, 2 * flow_radius + 1, produce_raw_flow)
+    raw_flows = _Window(frame_count, 2 * flow_radius + 1, produce_raw_flow, extrapolate=False)
 
     cache = GuideCache.create(
         cache_dir, frame_count=frame_count, height=shape[0], width=shape[1], border_width=border_width

@@ -15,7 +15,6 @@ HEIGHT, WIDTH = 80, 112
 YY, XX = np.mgrid[:HEIGHT, :WIDTH].astype(np.float64)
 PARAMS = guides.Params(blur_sigma=2.0, shape_radius=6.0, border_width=4.0)
 FRAMES = 22
-MIDDLE = range(9, 13)  # frames unaffected by the clamped ends of the temporal filters
 
 
 def disk(cx, cy, radius):
@@ -38,11 +37,13 @@ def growing(tmp_path_factory):
     return forward, reverse
 
 
-def test_translating_disk_flow_follows_the_motion(tmp_path):
+def test_translating_disk_flow_follows_the_motion_up_to_the_ends(tmp_path):
+    # the distances are extrapolated linearly past the sequence's ends, so the first and
+    # last frames read the full speed too (clamped, they read 0.6 of it)
     velocity = np.array([1.5, 0.5])
     masks = [disk(30 + velocity[0] * j, 34 + velocity[1] * j, 16) for j in range(FRAMES)]
     cache = guides.compute_guides(masks, FRAMES, params=PARAMS, cache_dir=tmp_path)
-    for j in MIDDLE:
+    for j in range(FRAMES):
         frame = cache.frame(j)
         ys, xs = np.nonzero(inner_boundary(frame.mask))
         normals = np.stack([xs - (30 + velocity[0] * j), ys - (34 + velocity[1] * j)], axis=1)
@@ -53,13 +54,18 @@ def test_translating_disk_flow_follows_the_motion(tmp_path):
         cosine = vectors @ velocity / np.linalg.norm(vectors, axis=1) / np.linalg.norm(velocity)
         assert cosine.min() >= 0.95
         np.testing.assert_allclose(np.linalg.norm(vectors, axis=1), np.abs(normals[lead_trail] @ velocity), rtol=0.15)
+        # the interior moves with the disk (not at the half speed of the normal motion
+        # alone); measured 2 % in the middle, up to 5.7 % at the ends, where the
+        # extrapolated distances are not quite a disk's
+        interior = frame.flow[frame.dist > 2]
+        assert np.linalg.norm(interior - velocity, axis=1).mean() < 0.07 * np.linalg.norm(velocity)
 
 
 def test_growing_disk_flow_points_outward_with_the_growth_rate(growing):
     forward, _ = growing
     radius = np.hypot(XX - 56, YY - 40)
     outward = np.stack([XX - 56, YY - 40], axis=2) / np.maximum(radius, 1e-9)[:, :, None]
-    for j in MIDDLE:
+    for j in range(FRAMES):
         frame = forward.frame(j)
         boundary = inner_boundary(frame.mask)
         speed = np.linalg.norm(frame.flow, axis=2)
