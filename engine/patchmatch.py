@@ -475,11 +475,108 @@ class PatchCost:
         )
 
 
+@dataclass(frozen=True)
+class SourceFeatures:
+    """The source half of a :class:`PatchCost`: quantized features and their layout.
+
+    Build it with :func:`quantize_source`; it can serve many targets (every frame of a
+    sequence) as long as their values lie inside the quantization ranges (others are
+    clipped to them).
+
+    Attributes
+    ----------
+    codes : ndarray, shape (T, Hs, Ws, F), uint16
+        Colour, guides without a weight map, then guides grouped by weight map.
+    offset, scale : ndarray, shape (F,), float32
+        Quantization of each feature: ``round((value − offset) · scale)``.
+    colour_channels : int
+    guide_order : ndarray of int, shape (G,)
+        The caller's guide channel stored at each guide feature.
+    guide_weight_map : ndarray of int, shape (G,)
+        Weight map of each guide (caller's order), -1 for none.
+    opposite_feature : ndarray, shape (F,), int64
+    use_opposite : bool
+    """
+
+    codes: np.ndarray
+    offset: np.ndarray
+    scale: np.ndarray
+    colour_channels: int
+    guide_order: np.ndarray
+    guide_weight_map: np.ndarray
+    opposite_feature: np.ndarray
+    use_opposite: bool
+
+    def in_feature_order(self, guides):
+        """Guide channels (..., G) in the caller's order, reordered as the features store them."""
+        return np.asarray(guides, np.float32)[..., self.guide_order]
+
+
+def quantize_source(source_colour, source_guides, *, guide_weight_map=None, opposite_guide=None, low=None, high=None):
+    """Quantize the source features over ranges that also cover given target values.
+
+    Parameters
+    ----------
+    source_colour : ndarray, shape (T, Hs, Ws, Cc), float32
+    source_guides : ndarray, shape (T, Hs, Ws, G), float32
+    guide_weight_map : array-like of int, shape (G,), optional
+        Index of the weight map that scales each guide channel, -1 for none.
+    opposite_guide : array-like of int, shape (G,), optional
+        Source guide channel compared with guide g when flows are opposite.
+    low, high : array-like, shape (Cc + G,), optional
+        Values (colour, then guides in the caller's order) each range must include
+        besides the source's own, e.g. the target's extremes.
+
+    Returns
+    -------
+    SourceFeatures
+    """
+    source_colour = np.asarray(source_colour, np.float32)
+    source_guides = np.asarray(source_guides, np.float32)
+    frames, source_height, source_width, colours = source_colour.shape
+    guides = source_guides.shape[3]
+    if guide_weight_map is None:
+        guide_weight_map = np.full(guides, -1, np.int64)
+    guide_weight_map = np.asarray(guide_weight_map, np.int64).reshape(guides)
+    # order guides: no map first, then by map index (stable)
+    order = np.argsort(np.where(guide_weight_map < 0, -1, guide_weight_map), kind="stable")
+    position = np.empty(guides, np.int64)
+    position[order] = np.arange(guides)
+    source_guides = source_guides[..., order]
+    opposite_feature = np.arange(colours + guides, dtype=np.int64)
+    use_opposite = opposite_guide is not None
+    if use_opposite:
+        opposite_guide = np.asarray(opposite_guide, np.int64).reshape(guides)
+        opposite_feature[colours + position] = colours + position[opposite_guide]
+    low_bound = np.concatenate([_channel_min(source_colour), _channel_min(source_guides)])
+    high_bound = np.concatenate([_channel_max(source_colour), _channel_max(source_guides)])
+    feature_order = np.concatenate([np.arange(colours), colours + order])
+    if low is not None:
+        low_bound = np.minimum(low_bound, np.asarray(low, np.float64).reshape(colours + guides)[feature_order])
+    if high is not None:
+        high_bound = np.maximum(high_bound, np.asarray(high, np.float64).reshape(colours + guides)[feature_order])
+    for _ in range(colours + guides):  # features swapped with each other share one range
+        low_bound = np.minimum(low_bound, low_bound[opposite_feature])
+        high_bound = np.maximum(high_bound, high_bound[opposite_feature])
+    span = high_bound - low_bound
+    scale = np.where(span > 0, _CODE_MAX / np.where(span > 0, span, 1.0), 1.0).astype(np.float32)
+    offset = low_bound.astype(np.float32)
+    codes = np.empty((frames, source_height, source_width, colours + guides), _CODE)
+    _quantize(source_colour, offset[:colours], scale[:colours], codes, 0)
+    _quantize(source_guides, offset[colours:], scale[colours:], codes, colours)
+    return SourceFeatures(
+        codes=codes, offset=offset, scale=scale, colour_channels=colours, guide_order=order,
+        guide_weight_map=guide_weight_map, opposite_feature=opposite_feature, use_opposite=use_opposite,
+    )
+
+
 def build_patch_cost(*, source_colour, source_guides, target_colour, target_guides, colour_weights, guide_weights,
                      guide_weight_map=None, weight_maps=None, opposite_guide=None, source_angle=None,
                      target_angle=None, orientation_weight=0.0, orientation_clamp=10.0, source_segment=None,
                      target_segment=None, patch_size=5):
     """Assemble a :class:`PatchCost` from colour and guide channels.
+
+    The quantization ranges span both the source and the target values.
 
     Parameters
     ----------
@@ -488,16 +585,48 @@ def build_patch_cost(*, source_colour, source_guides, target_colour, target_guid
     target_colour : ndarray, shape (H, W, Cc), float32
         The current synthesized colour.
     target_guides : ndarray, shape (H, W, G), float32
+    colour_weights, guide_weights, weight_maps, source_angle, target_angle, orientation_weight,
+    orientation_clamp, source_segment, target_segment, patch_size
+        As in :func:`target_patch_cost`.
+    guide_weight_map, opposite_guide
+        As in :func:`quantize_source` (swapped guides must have equal weights).
+
+    Returns
+    -------
+    PatchCost
+    """
+    target_colour = np.asarray(target_colour, np.float32)
+    target_guides = np.asarray(target_guides, np.float32)
+    features = quantize_source(
+        source_colour, source_guides, guide_weight_map=guide_weight_map, opposite_guide=opposite_guide,
+        low=np.concatenate([_channel_min(target_colour), _channel_min(target_guides)]),
+        high=np.concatenate([_channel_max(target_colour), _channel_max(target_guides)]),
+    )
+    return target_patch_cost(
+        features, target_colour=target_colour, target_guides=target_guides, colour_weights=colour_weights,
+        guide_weights=guide_weights, weight_maps=weight_maps, source_angle=source_angle, target_angle=target_angle,
+        orientation_weight=orientation_weight, orientation_clamp=orientation_clamp, source_segment=source_segment,
+        target_segment=target_segment, patch_size=patch_size,
+    )
+
+
+def target_patch_cost(features, *, target_colour, target_guides, colour_weights, guide_weights, weight_maps=None,
+                      source_angle=None, target_angle=None, orientation_weight=0.0, orientation_clamp=10.0,
+                      source_segment=None, target_segment=None, patch_size=5):
+    """Assemble a :class:`PatchCost` of a target against quantized source features.
+
+    Parameters
+    ----------
+    features : SourceFeatures
+    target_colour : ndarray, shape (H, W, Cc), float32
+        The current synthesized colour.
+    target_guides : ndarray, shape (H, W, G), float32
+        Guides in the caller's order (as given to :func:`quantize_source`).
     colour_weights : array-like, shape (Cc,)
     guide_weights : array-like, shape (G,)
         Non-negative weights.
-    guide_weight_map : array-like of int, shape (G,), optional
-        Index into ``weight_maps`` per guide channel, -1 for none.
     weight_maps : ndarray, shape (M, H, W), float32, optional
-        Per-target-pixel weight multipliers.
-    opposite_guide : array-like of int, shape (G,), optional
-        Source guide channel compared with guide g when flows are opposite
-        (requires the angles; swapped guides must have equal weights).
+        Per-target-pixel weight multipliers (``features.guide_weight_map`` indexes them).
     source_angle, target_angle : ndarray, (T, Hs, Ws) and (H, W), float32, optional
         Flow orientations in radians.
     orientation_weight, orientation_clamp : float
@@ -510,56 +639,31 @@ def build_patch_cost(*, source_colour, source_guides, target_colour, target_guid
     -------
     PatchCost
     """
-    source_colour = np.asarray(source_colour, np.float32)
-    source_guides = np.asarray(source_guides, np.float32)
+    frames, source_height, source_width = features.codes.shape[:3]
+    colours = features.colour_channels
+    guides = features.guide_order.shape[0]
     target_guides = np.asarray(target_guides, np.float32)
-    frames, source_height, source_width, colours = source_colour.shape
-    guides = source_guides.shape[3]
     height, width = target_guides.shape[:2]
+    if target_guides.shape[2] != guides:
+        raise ValueError(f"target_guides must have {guides} channels, got {target_guides.shape[2]}")
     colour_weights = np.asarray(colour_weights, np.float32).reshape(colours)
     guide_weights = np.asarray(guide_weights, np.float32).reshape(guides)
     if (colour_weights < 0).any() or (guide_weights < 0).any():
         raise ValueError("weights must be non-negative")
-    if guide_weight_map is None:
-        guide_weight_map = np.full(guides, -1, np.int64)
-    guide_weight_map = np.asarray(guide_weight_map, np.int64).reshape(guides)
+    guide_weight_map = features.guide_weight_map
     maps = 0 if weight_maps is None else weight_maps.shape[0]
     if guide_weight_map.max(initial=-1) >= maps:
         raise ValueError(f"guide_weight_map refers to map {guide_weight_map.max()} but {maps} weight maps were given")
-    # order guides: no map first, then by map index (stable)
-    order = np.argsort(np.where(guide_weight_map < 0, -1, guide_weight_map), kind="stable")
-    position = np.empty(guides, np.int64)
-    position[order] = np.arange(guides)
     group_ends = np.array([colours + np.count_nonzero(guide_weight_map <= m) for m in range(maps)], np.int64)
     plain_end = colours + int(np.count_nonzero(guide_weight_map < 0))
-    source_guides = source_guides[..., order]
-    target_guides = target_guides[..., order]
-    opposite_feature = np.arange(colours + guides, dtype=np.int64)
-    use_opposite = opposite_guide is not None
-    if use_opposite:
-        opposite_guide = np.asarray(opposite_guide, np.int64).reshape(guides)
-        if (guide_weights[opposite_guide] != guide_weights).any():
-            raise ValueError("guides swapped by opposite_guide must have equal weights")
-        opposite_feature[colours + position] = colours + position[opposite_guide]
-    # ranges span both sides; later votes, averages of source colours, stay inside
-    target_colour = np.asarray(target_colour, np.float32)
-    low = np.concatenate([np.minimum(_channel_min(source_colour), _channel_min(target_colour)),
-                          np.minimum(_channel_min(source_guides), _channel_min(target_guides))])
-    high = np.concatenate([np.maximum(_channel_max(source_colour), _channel_max(target_colour)),
-                           np.maximum(_channel_max(source_guides), _channel_max(target_guides))])
-    for _ in range(colours + guides):  # features swapped with each other share one range
-        low, high = np.minimum(low, low[opposite_feature]), np.maximum(high, high[opposite_feature])
-    span = high - low
-    scale = np.where(span > 0, _CODE_MAX / np.where(span > 0, span, 1.0), 1.0).astype(np.float32)
-    offset = low.astype(np.float32)
-    source_codes = np.empty((frames, source_height, source_width, colours + guides), _CODE)
+    weights = np.concatenate([colour_weights, guide_weights[features.guide_order]])
+    if (weights[features.opposite_feature] != weights).any():
+        raise ValueError("guides swapped by opposite_guide must have equal weights")
+    offset, scale = features.offset, features.scale
     target_codes = np.empty((height, width, colours + guides), _CODE)
-    for values, codes in ((source_colour, source_codes), (target_colour, target_codes)):
-        _quantize(values, offset[:colours], scale[:colours], codes, 0)
-    for values, codes in ((source_guides, source_codes), (target_guides, target_codes)):
-        _quantize(values, offset[colours:], scale[colours:], codes, colours)
-    weights = np.concatenate([colour_weights, guide_weights[order]])
-    needs_angles = use_opposite or orientation_weight > 0
+    _quantize(target_colour, offset[:colours], scale[:colours], target_codes, 0)
+    _quantize(features.in_feature_order(target_guides), offset[colours:], scale[colours:], target_codes, colours)
+    needs_angles = features.use_opposite or orientation_weight > 0
     if needs_angles and (source_angle is None or target_angle is None):
         raise ValueError("the orientation term and opposite-flow swapping need source_angle and target_angle")
     if source_angle is None:
@@ -572,7 +676,7 @@ def build_patch_cost(*, source_colour, source_guides, target_colour, target_guid
     if weight_maps is None:
         weight_maps = np.zeros((0, height, width), np.float32)
     return PatchCost(
-        source_features=source_codes,
+        source_features=features.codes,
         target_features=target_codes,
         feature_offset=offset,
         feature_scale=scale,
@@ -581,8 +685,8 @@ def build_patch_cost(*, source_colour, source_guides, target_colour, target_guid
         plain_end=plain_end,
         group_ends=group_ends,
         weight_maps=np.ascontiguousarray(weight_maps, np.float32),
-        opposite_feature=opposite_feature,
-        use_opposite=use_opposite,
+        opposite_feature=features.opposite_feature,
+        use_opposite=features.use_opposite,
         source_angle=np.ascontiguousarray(source_angle, np.float32),
         target_angle=np.ascontiguousarray(target_angle, np.float32),
         orientation_weight=float(orientation_weight),

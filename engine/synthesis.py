@@ -16,10 +16,10 @@ import numpy as np
 from fluidymation.engine.nnf import (
     NNF, ROTATION_FLOW, ROTATION_NONE, downscale_nnf, fill_random, merge_nnf, segment_index, upscale_nnf,
 )
-from fluidymation.engine.patchmatch import TILE_ROWS, build_patch_cost, patch_errors, patchmatch_pass
-from fluidymation.engine.pyramid import (
-    downsample, downsample_angles, downsample_labels, gaussian_pyramid, levels_that_fit,
+from fluidymation.engine.patchmatch import (
+    TILE_ROWS, SourceFeatures, patch_errors, patchmatch_pass, quantize_source, target_patch_cost,
 )
+from fluidymation.engine.pyramid import downsample, downsample_angles, downsample_labels, gaussian_pyramid, levels_that_fit
 from fluidymation.engine.uniformity import budget_scales, occurrence_map, uniformity_penalty
 from fluidymation.engine.vote import vote
 
@@ -159,31 +159,90 @@ class SynthesisResult:
         return float(finite.mean()) if finite.size else float("nan")
 
 
-def _check_inputs(inputs):
-    colour = inputs.source_colour
+@dataclass(frozen=True)
+class TargetInputs:
+    """The target side of :func:`synthesize_prepared` (the fields of :class:`SynthesisInputs`
+    that describe the target; ``target_guides`` in the prepared source's guide order)."""
+
+    target_guides: np.ndarray
+    colour_weights: np.ndarray
+    guide_weights: np.ndarray
+    weight_maps: np.ndarray | None = None
+    target_angle: np.ndarray | None = None
+    target_segment: np.ndarray | None = None
+    initial_nnf: NNF | None = None
+
+
+@dataclass(frozen=True)
+class SourceLevel:
+    """One pyramid level of a :class:`PreparedSource`.
+
+    Attributes
+    ----------
+    colour : ndarray, shape (T, Hs, Ws, Cc), float32
+        What is voted.
+    features : SourceFeatures
+        Colour and guides, quantized.
+    angle : ndarray, shape (T, Hs, Ws), float32, or None
+    segment : ndarray, shape (T, Hs, Ws), int32
+    index : tuple
+        :func:`segment_index` of ``segment``.
+    """
+
+    colour: np.ndarray
+    features: SourceFeatures
+    angle: np.ndarray | None
+    segment: np.ndarray
+    index: tuple
+
+
+@dataclass(frozen=True)
+class PreparedSource:
+    """A source sequence's pyramid and features, built once by :func:`prepare_source` and
+    shared by every target synthesized from it (e.g. every frame of a sequence).
+
+    Attributes
+    ----------
+    levels : tuple of SourceLevel
+        Finest first.
+    """
+
+    levels: tuple
+
+    @property
+    def shape(self):
+        """(T, Hs, Ws, Cc) of the finest level's colour."""
+        return self.levels[0].colour.shape
+
+    @property
+    def guide_channels(self):
+        return self.levels[0].features.guide_order.shape[0]
+
+
+def _check_source(colour, guides, angle, segment):
     if colour.ndim != 4:
         raise ValueError(f"source_colour must have shape (T, Hs, Ws, Cc), got {colour.shape}")
-    frames, source_height, source_width, colours = colour.shape
-    guides = inputs.source_guides
     if guides.ndim != 4 or guides.shape[:3] != colour.shape[:3]:
         raise ValueError(f"source_guides must have shape {colour.shape[:3] + ('G',)}, got {guides.shape}")
-    target = inputs.target_guides
-    if target.ndim != 3 or target.shape[2] != guides.shape[3]:
-        raise ValueError(f"target_guides must have shape (H, W, {guides.shape[3]}), got {target.shape}")
-    height, width = target.shape[:2]
-    if np.shape(inputs.colour_weights) != (colours,) or np.shape(inputs.guide_weights) != (guides.shape[3],):
+    for name, value in (("source_angle", angle), ("source_segment", segment)):
+        if value is not None and value.shape != colour.shape[:3]:
+            raise ValueError(f"{name} must have shape {colour.shape[:3]}, got {value.shape}")
+
+
+def _check_target(target, colours, guides):
+    target_guides = target.target_guides
+    if target_guides.ndim != 3 or target_guides.shape[2] != guides:
+        raise ValueError(f"target_guides must have shape (H, W, {guides}), got {target_guides.shape}")
+    height, width = target_guides.shape[:2]
+    if np.shape(target.colour_weights) != (colours,) or np.shape(target.guide_weights) != (guides,):
         raise ValueError("colour_weights and guide_weights need one weight per channel")
-    shapes = {
-        "weight_maps": (None, height, width), "source_angle": (frames, source_height, source_width),
-        "target_angle": (height, width), "source_segment": (frames, source_height, source_width),
-        "target_segment": (height, width),
-    }
+    shapes = {"weight_maps": (None, height, width), "target_angle": (height, width), "target_segment": (height, width)}
     for name, shape in shapes.items():
-        value = getattr(inputs, name)
+        value = getattr(target, name)
         if value is not None and (value.ndim != len(shape) or any(s is not None and s != v for s, v in zip(shape, value.shape))):
             raise ValueError(f"{name} must have shape {shape}, got {value.shape}")
-    if inputs.initial_nnf is not None and inputs.initial_nnf.shape != (height, width):
-        raise ValueError(f"initial_nnf must have shape {(height, width)}, got {inputs.initial_nnf.shape}")
+    if target.initial_nnf is not None and target.initial_nnf.shape != (height, width):
+        raise ValueError(f"initial_nnf must have shape {(height, width)}, got {target.initial_nnf.shape}")
 
 
 def _schedule(values, index):
@@ -203,8 +262,76 @@ def _downsample_maps(maps):
     return np.ascontiguousarray(np.moveaxis(downsample(np.moveaxis(maps, 0, -1)), -1, 0))
 
 
+def _channel_range(values):
+    """Per-channel (min, max) of (..., C) values, float64."""
+    flat = values.reshape(-1, values.shape[-1])
+    return flat.min(axis=0, initial=np.inf).astype(np.float64), flat.max(axis=0, initial=-np.inf).astype(np.float64)
+
+
+def _prepare(source_colour, source_guides, guide_weight_map, opposite_guide, source_angle, source_segment, ranges):
+    """Prepare ``len(ranges)`` levels; ``ranges[l]`` = the (low, high) guide values level l must cover."""
+    levels = len(ranges)
+    frames, source_height, source_width, colours = source_colour.shape
+    if source_segment is None:
+        source_segment = np.zeros((frames, source_height, source_width), np.int32)
+    colour = gaussian_pyramid(source_colour, levels)
+    guides = gaussian_pyramid(source_guides, levels)
+    angle = _pyramid_or_none(source_angle, levels, downsample_angles)
+    segment = _pyramid_or_none(np.asarray(source_segment, np.int32), levels, downsample_labels)
+    unvoted = np.zeros(colours)  # the colour before the first vote, and where no patch votes
+    prepared = []
+    for level, (low, high) in enumerate(ranges):
+        features = quantize_source(
+            colour[level], guides[level], guide_weight_map=guide_weight_map, opposite_guide=opposite_guide,
+            low=np.concatenate([unvoted, low]), high=np.concatenate([unvoted, high]),
+        )
+        prepared.append(SourceLevel(colour=colour[level], features=features, angle=angle[level],
+                                    segment=segment[level], index=segment_index(segment[level])))
+    return PreparedSource(levels=tuple(prepared))
+
+
+def prepare_source(source_colour, source_guides, *, guide_weight_map=None, opposite_guide=None, source_angle=None,
+                   source_segment=None, guide_range=None, params=SynthesisParams()):
+    """Build a source's pyramid and quantized features once, for many :func:`synthesize_prepared` calls.
+
+    Parameters
+    ----------
+    source_colour, source_guides, guide_weight_map, opposite_guide, source_angle, source_segment
+        As in :class:`SynthesisInputs`.
+    guide_range : (low, high), each array-like of shape (G,), optional
+        Values the targets' guides may take besides the source's own: the features are
+        quantized over the union, target values outside it are clipped to it.
+    params : SynthesisParams
+        Its ``patch_size`` and ``pyramid_levels`` decide the levels prepared.
+
+    Returns
+    -------
+    PreparedSource
+    """
+    source_colour = np.asarray(source_colour, np.float32)
+    source_guides = np.asarray(source_guides, np.float32)
+    _check_source(source_colour, source_guides, source_angle, source_segment)
+    fit = levels_that_fit([source_colour.shape[1:3]], patch_size=params.patch_size)
+    levels = fit if params.pyramid_levels is None else min(params.pyramid_levels, fit)
+    guides = source_guides.shape[3]
+    low, high = (np.full(guides, np.inf), np.full(guides, -np.inf)) if guide_range is None else guide_range
+    low = np.asarray(low, np.float64).reshape(guides)
+    high = np.asarray(high, np.float64).reshape(guides)
+    return _prepare(source_colour, source_guides, guide_weight_map, opposite_guide, source_angle, source_segment,
+                    [(low, high)] * levels)
+
+
+def _level_count(source_shape, target_shape, params):
+    fit = levels_that_fit([source_shape, target_shape], patch_size=params.patch_size)
+    return fit if params.pyramid_levels is None else min(params.pyramid_levels, fit)
+
+
 def synthesize(inputs, params=SynthesisParams()):
     """Synthesize a target image from a source sequence with guided patch optimisation.
+
+    The source features are quantized over ranges spanning both the source and this
+    target. To synthesize many targets from one source, use :func:`prepare_source` and
+    :func:`synthesize_prepared`.
 
     Parameters
     ----------
@@ -215,73 +342,100 @@ def synthesize(inputs, params=SynthesisParams()):
     -------
     SynthesisResult
     """
-    _check_inputs(inputs)
-    frames, source_height, source_width, colours = inputs.source_colour.shape
-    height, width = inputs.target_guides.shape[:2]
-    fit = levels_that_fit([(source_height, source_width), (height, width)], patch_size=params.patch_size)
-    levels = fit if params.pyramid_levels is None else min(params.pyramid_levels, fit)
+    source_colour = np.asarray(inputs.source_colour, np.float32)
+    source_guides = np.asarray(inputs.source_guides, np.float32)
+    _check_source(source_colour, source_guides, inputs.source_angle, inputs.source_segment)
+    target = TargetInputs(
+        target_guides=inputs.target_guides, colour_weights=inputs.colour_weights, guide_weights=inputs.guide_weights,
+        weight_maps=inputs.weight_maps, target_angle=inputs.target_angle, target_segment=inputs.target_segment,
+        initial_nnf=inputs.initial_nnf,
+    )
+    _check_target(target, source_colour.shape[3], source_guides.shape[3])
+    levels = _level_count(source_colour.shape[1:3], target.target_guides.shape[:2], params)
+    target_guides = gaussian_pyramid(target.target_guides, levels)
+    source = _prepare(source_colour, source_guides, inputs.guide_weight_map, inputs.opposite_guide,
+                      inputs.source_angle, inputs.source_segment, [_channel_range(level) for level in target_guides])
+    return _synthesize(source, target, params, target_guides)
+
+
+def synthesize_prepared(source, target, params=SynthesisParams()):
+    """Synthesize a target image from a :class:`PreparedSource` (see :func:`synthesize`).
+
+    Parameters
+    ----------
+    source : PreparedSource
+        Prepared with the same ``patch_size`` and ``pyramid_levels`` as ``params``.
+    target : TargetInputs
+    params : SynthesisParams
+
+    Returns
+    -------
+    SynthesisResult
+    """
+    _, source_height, source_width, colours = source.shape
+    _check_target(target, colours, source.guide_channels)
+    levels = _level_count((source_height, source_width), target.target_guides.shape[:2], params)
+    if levels > len(source.levels):
+        raise ValueError(f"the source was prepared with {len(source.levels)} levels, these params need {levels}")
+    return _synthesize(source, target, params, gaussian_pyramid(target.target_guides, levels))
+
+
+def _synthesize(source, target, params, target_guides):
+    """The multi-scale loop over the levels of ``target_guides`` (a pyramid, finest first)."""
+    levels = len(target_guides)
+    colours = source.shape[3]
+    height, width = target_guides[0].shape[:2]
     rotation_mode = _ROTATIONS[params.rotation]
-    if rotation_mode == ROTATION_FLOW and (inputs.source_angle is None or inputs.target_angle is None):
+    if rotation_mode == ROTATION_FLOW and (source.levels[0].angle is None or target.target_angle is None):
         raise ValueError('rotation="flow" needs source_angle and target_angle')
 
-    source_segment = inputs.source_segment
-    if source_segment is None:
-        source_segment = np.zeros((frames, source_height, source_width), np.int32)
-    target_segment = inputs.target_segment
+    target_segment = target.target_segment
     if target_segment is None:
         target_segment = np.zeros((height, width), np.int32)
-    source_colour = gaussian_pyramid(inputs.source_colour, levels)
-    source_guides = gaussian_pyramid(inputs.source_guides, levels)
-    target_guides = gaussian_pyramid(inputs.target_guides, levels)
-    weight_maps = _pyramid_or_none(inputs.weight_maps, levels, _downsample_maps)
-    source_angle = _pyramid_or_none(inputs.source_angle, levels, downsample_angles)
-    target_angle = _pyramid_or_none(inputs.target_angle, levels, downsample_angles)
-    source_segments = _pyramid_or_none(np.asarray(source_segment, np.int32), levels, downsample_labels)
+    weight_maps = _pyramid_or_none(target.weight_maps, levels, _downsample_maps)
+    target_angle = _pyramid_or_none(target.target_angle, levels, downsample_angles)
     target_segments = _pyramid_or_none(np.asarray(target_segment, np.int32), levels, downsample_labels)
 
     nnf = None
     for rank, level in enumerate(range(levels - 1, -1, -1)):
+        prepared = source.levels[level]
         level_height, level_width = target_guides[level].shape[:2]
-        level_source_shape = source_colour[level].shape[1:3]
-        cost = build_patch_cost(
-            source_colour=source_colour[level], source_guides=source_guides[level],
-            target_colour=np.zeros((level_height, level_width, colours), np.float32),
-            target_guides=target_guides[level], colour_weights=inputs.colour_weights,
-            guide_weights=inputs.guide_weights, guide_weight_map=inputs.guide_weight_map,
-            weight_maps=weight_maps[level], opposite_guide=inputs.opposite_guide,
-            source_angle=source_angle[level], target_angle=target_angle[level],
-            orientation_weight=params.orientation_weight, orientation_clamp=params.orientation_clamp,
-            source_segment=source_segments[level], target_segment=target_segments[level],
-            patch_size=params.patch_size,
+        level_source_shape = prepared.colour.shape[1:3]
+        cost = target_patch_cost(
+            prepared.features, target_colour=np.zeros((level_height, level_width, colours), np.float32),
+            target_guides=target_guides[level], colour_weights=target.colour_weights,
+            guide_weights=target.guide_weights, weight_maps=weight_maps[level], source_angle=prepared.angle,
+            target_angle=target_angle[level], orientation_weight=params.orientation_weight,
+            orientation_clamp=params.orientation_clamp, source_segment=prepared.segment,
+            target_segment=target_segments[level], patch_size=params.patch_size,
         )
-        index = segment_index(cost.source_segment)
 
         def repair(field, salt):
             fill_random(
                 field, target_segment=cost.target_segment, source_segment=cost.source_segment, seed=params.seed, salt=salt, replace_all=False,
-                rotation_mode=rotation_mode, target_angle=target_angle[level], source_angle=source_angle[level],
-                index=index,
+                rotation_mode=rotation_mode, target_angle=target_angle[level], source_angle=prepared.angle,
+                index=prepared.index,
             )
 
         def revote():
-            colour, _ = vote(source_colour[level], nnf, patch_size=params.patch_size)
+            colour, _ = vote(prepared.colour, nnf, patch_size=params.patch_size)
             cost.set_target_colour(colour)
             return colour
 
         def downscaled_initial():
-            field = downscale_nnf(inputs.initial_nnf, steps=level, target_shape=(level_height, level_width),
+            field = downscale_nnf(target.initial_nnf, steps=level, target_shape=(level_height, level_width),
                                   source_shape=level_source_shape)
             repair(field, _salt(level, 1, 0, 0))
             return field
 
-        random_start = nnf is None and inputs.initial_nnf is None
+        random_start = nnf is None and target.initial_nnf is None
         if nnf is None:
-            nnf = downscaled_initial() if inputs.initial_nnf is not None else NNF.empty(level_height, level_width)
+            nnf = downscaled_initial() if target.initial_nnf is not None else NNF.empty(level_height, level_width)
             repair(nnf, _salt(level, 0, 0, 0))
         else:
             nnf = upscale_nnf(nnf, target_shape=(level_height, level_width), source_shape=level_source_shape)
             repair(nnf, _salt(level, 0, 0, 0))
-            if inputs.initial_nnf is not None:
+            if target.initial_nnf is not None:
                 revote()
                 other = downscaled_initial()
                 nnf, _ = merge_nnf(nnf, other, patch_errors(cost, nnf), patch_errors(cost, other))

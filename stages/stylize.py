@@ -30,7 +30,8 @@ import numpy as np
 from fluidymation.engine.nnf import NNF
 from fluidymation.engine.random import counter_hash
 from fluidymation.engine.shiftnnf import shift_nnf, temporal_modulation
-from fluidymation.engine.synthesis import SynthesisInputs, SynthesisParams, synthesize
+from fluidymation.engine.synthesis import SynthesisParams, TargetInputs, synthesize_prepared
+from fluidymation.engine.synthesis import prepare_source as prepare_engine_source
 from fluidymation.engine.vote import vote
 from fluidymation.errors import StageError
 from fluidymation.stages import guides
@@ -232,9 +233,17 @@ def stylize_sequence(
         orientation_weight=params.w_dir, orientation_clamp=params.dir_clamp, rotation="flow", seed=params.seed,
     )
     unit = np.float32(1.0 / params.ext_unit)
-    source_guides = np.concatenate([
-        source.shape[..., None], source.ext_plus[..., None] * unit, source.ext_minus[..., None] * unit, source.rgb,
-    ], axis=3)
+    # the exemplar's pyramid and features, once for every frame; the target's guides span
+    # shape [0, 1], ext± up to the sequence's largest and a temporal guide of exemplar colours (0 where unvoted)
+    ext_max = max(target.meta["ext_plus_max"], target.meta["ext_minus_max"]) * unit
+    prepared = prepare_engine_source(
+        source.rgb, np.concatenate([
+            source.shape[..., None], source.ext_plus[..., None] * unit, source.ext_minus[..., None] * unit, source.rgb,
+        ], axis=3),
+        guide_weight_map=_WEIGHT_MAP, opposite_guide=_OPPOSITE, source_angle=source.angle,
+        source_segment=source.segment, guide_range=([0.0] * 6, [1.0, ext_max, ext_max, 1.0, 1.0, 1.0]),
+        params=synthesis,
+    )
     guide_weights = np.array([params.w_bound, params.w_ext, params.w_ext] + [params.w_temp] * 3, np.float32)
 
     previous = None  # (NNF, inside mask, ext+, motion not yet followed) of the frame processed before
@@ -266,13 +275,11 @@ def stylize_sequence(
         target_guides = np.concatenate([
             frame.shape[..., None], frame.ext_plus[..., None] * unit, frame.ext_minus[..., None] * unit, temp,
         ], axis=2)
-        result = synthesize(
-            SynthesisInputs(
-                source_colour=source.rgb, source_guides=source_guides, target_guides=target_guides,
-                colour_weights=np.ones(3, np.float32), guide_weights=guide_weights, weight_maps=modulation,
-                guide_weight_map=_WEIGHT_MAP, opposite_guide=_OPPOSITE, source_angle=source.angle,
-                target_angle=frame.direction, source_segment=source.segment, target_segment=segment,
-                initial_nnf=initial,
+        result = synthesize_prepared(
+            prepared,
+            TargetInputs(
+                target_guides=target_guides, colour_weights=np.ones(3, np.float32), guide_weights=guide_weights,
+                weight_maps=modulation, target_angle=frame.direction, target_segment=segment, initial_nnf=initial,
             ),
             dataclasses.replace(synthesis, seed=int(counter_hash(params.seed, k) % np.uint64(2**31))),
         )

@@ -4,7 +4,9 @@ import pytest
 from scipy.ndimage import gaussian_filter
 
 from fluidymation.engine.nnf import NNF
-from fluidymation.engine.synthesis import SynthesisInputs, SynthesisParams, synthesize
+from fluidymation.engine.synthesis import (
+    SynthesisInputs, SynthesisParams, TargetInputs, prepare_source, synthesize, synthesize_prepared,
+)
 
 
 def texture(shape, seed, sigma=1.5):
@@ -168,6 +170,48 @@ def test_initial_field_is_used_when_it_is_better():
     seeded = SynthesisInputs(**{**inputs.__dict__, "initial_nnf": identity})
     result = synthesize(seeded, SynthesisParams(seed=0, search_vote_iters=(0,), patchmatch_iters=(0,)))
     np.testing.assert_array_equal(result.nnf.coords, identity.coords)
+
+
+def prepared_and_target(inputs, params, guide_range=None):
+    source = prepare_source(
+        inputs.source_colour, inputs.source_guides, guide_weight_map=inputs.guide_weight_map,
+        opposite_guide=inputs.opposite_guide, source_angle=inputs.source_angle, source_segment=inputs.source_segment,
+        guide_range=guide_range, params=params,
+    )
+    target = TargetInputs(
+        target_guides=inputs.target_guides, colour_weights=inputs.colour_weights, guide_weights=inputs.guide_weights,
+        weight_maps=inputs.weight_maps, target_angle=inputs.target_angle, target_segment=inputs.target_segment,
+        initial_nnf=inputs.initial_nnf,
+    )
+    return source, target
+
+
+def test_a_prepared_source_gives_the_same_result_over_the_same_ranges():
+    # one level: synthesize quantizes over the source's and this target's ranges, which the prepared source is given
+    inputs = full_featured_inputs()
+    params = SynthesisParams(**{**FULL_PARAMS.__dict__, "pyramid_levels": 1})
+    guides = inputs.target_guides.reshape(-1, 3)
+    source, target = prepared_and_target(inputs, params, guide_range=(guides.min(axis=0), guides.max(axis=0)))
+    expected = synthesize(inputs, params)
+    for _ in range(2):  # the prepared source is not consumed
+        result = synthesize_prepared(source, target, params)
+        assert result.image.tobytes() == expected.image.tobytes()
+        assert result.nnf.coords.tobytes() == expected.nnf.coords.tobytes()
+        assert result.error.tobytes() == expected.error.tobytes()
+
+
+def test_a_prepared_source_serves_targets_of_other_sizes_and_refuses_too_few_levels():
+    inputs = full_featured_inputs()
+    source, target = prepared_and_target(inputs, FULL_PARAMS)
+    assert len(source.levels) == 2  # 30×34 px with 5 px patches
+    smaller = TargetInputs(**{**target.__dict__, "target_guides": inputs.target_guides[:20, :22],
+                              "weight_maps": inputs.weight_maps[:, :20, :22], "target_angle": inputs.target_angle[:20, :22],
+                              "target_segment": inputs.target_segment[:20, :22], "initial_nnf": None})
+    result = synthesize_prepared(source, smaller, FULL_PARAMS)
+    assert result.image.shape == (20, 22, 3) and (result.nnf.frame[3:, 3:] >= 0).all()
+    one_level, _ = prepared_and_target(inputs, SynthesisParams(pyramid_levels=1))
+    with pytest.raises(ValueError, match="prepared with 1 levels"):
+        synthesize_prepared(one_level, target, FULL_PARAMS)
 
 
 @pytest.mark.parametrize("bad", [dict(patch_size=4), dict(alpha=1.0), dict(rotation="spin"), dict(search_vote_iters=())])
