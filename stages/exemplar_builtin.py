@@ -27,6 +27,7 @@ from scipy import ndimage
 
 from fluidymation.engine import crumble, watercolor
 from fluidymation.errors import StageError
+from fluidymation.stages.colour import parse_hex
 
 NAME = "exemplar_builtin"
 VERSION = 1
@@ -115,11 +116,6 @@ def generate(params: Params, *, progress=None):
     return rgb, mask, flow
 
 
-def hex_to_rgb(colour: str) -> np.ndarray:
-    """``#rrggbb`` to a (3,) float32 sRGB colour in [0, 1]."""
-    return np.array([int(colour[i : i + 2], 16) for i in (1, 3, 5)], dtype=np.float32) / 255.0
-
-
 # --------------------------------------------------------------------------- cache
 
 
@@ -181,7 +177,7 @@ def _paper(params: Params):
 
 def _pigment_coefficients(colour: str):
     """KM coefficients of a transparent pigment whose unit layer over white shows ``colour``."""
-    over_white = np.clip(watercolor.srgb_to_linear(hex_to_rgb(colour)), 0.004, 0.97)
+    over_white = np.clip(watercolor.srgb_to_linear(parse_hex(colour)), 0.004, 0.97)
     return watercolor.km_coefficients(over_white, 0.25 * over_white)
 
 
