@@ -81,20 +81,43 @@ def test_painted_area_follows_the_target(source, tmp_path):
         assert (painted & target).sum() / (painted | target).sum() >= 0.95
 
 
-@pytest.mark.xfail(reason="open (issue 6): contrast is 0.76-0.80 of the exemplar's on this 48 px scene and the "
-                          "texture of a translating disk mostly stays in place (see docs/stylize.md)")
-def test_texture_is_kept_and_moves_with_the_shape(source, tmp_path):
+def test_texture_moves_with_the_shape(source, tmp_path):
+    # the disk moves 4 px: the last frame matches the first shifted by 4 px far better
+    # than unshifted (measured 0.26 of it; 1.4 before the flow's tangential part, when
+    # the interior read half the speed)
+    frames = _run(moving, 5, source, tmp_path)
+    first, last = frames[0].rgba[..., :3], frames[-1].rgba[..., :3]
+    inner = ndimage.binary_erosion(moving(0) > 0.5, iterations=4)
+    inner_shifted = np.roll(inner, 4, axis=1)
+    both = inner & inner_shifted
+    assert np.abs(np.roll(first, 4, axis=1) - last)[both].mean() < 0.5 * np.abs(first - last)[both].mean()
+
+
+@pytest.mark.xfail(reason="open (issue 6): the first frame's local contrast depends on the seed (0.75-0.92 of the "
+                          "exemplar's over seeds 0-7; seed 0 is the worst, 0.75) and later frames keep it; "
+                          "see docs/stylize.md")
+def test_texture_is_not_washed_out(source, tmp_path):
     frames = _run(moving, 5, source, tmp_path)
     exemplar_contrast = np.mean([_local_contrast(source.rgb[i], source.segment[i] >= 0)
                                  for i in range(source.frame_count)])
     for frame in frames:
         assert _local_contrast(frame.rgba, moving(frame.index) > 0.5) >= 0.8 * exemplar_contrast
-    # the disk moves 4 px: the last frame should match the first shifted by 4 px better than unshifted
-    first, last = frames[0].rgba[..., :3], frames[-1].rgba[..., :3]
-    inner = ndimage.binary_erosion(moving(0) > 0.5, iterations=4)
-    inner_shifted = np.roll(inner, 4, axis=1)
-    both = inner & inner_shifted
-    assert np.abs(np.roll(first, 4, axis=1) - last)[both].mean() < np.abs(first - last)[both].mean()
+
+
+def test_moving_regions_change_more_than_stationary_ones(source, tmp_path):
+    def still_part(j):
+        return _disk(11, radius=8.0)
+
+    def moving_part(j):
+        return _disk(32 + j, radius=9.0)
+
+    frames = _run(lambda j: np.maximum(still_part(j), moving_part(j)), 5, source, tmp_path)
+    still = ndimage.binary_erosion(still_part(0) > 0.5, iterations=2)
+    for a, b in zip(frames, frames[1:]):
+        moved = ndimage.binary_erosion((moving_part(a.index) > 0.5) & (moving_part(b.index) > 0.5), iterations=2)
+        change = np.abs(a.rgba - b.rgba)[..., :3].mean(axis=2)
+        # measured 1.9-6.7 times (seeds 0 and 1)
+        assert change[moved].mean() > 1.5 * change[still].mean()
 
 
 def test_stationary_regions_change_less_with_the_temporal_term(source, tmp_path):
