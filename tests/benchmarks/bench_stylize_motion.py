@@ -4,7 +4,8 @@ Run: ``NUMBA_CACHE_DIR=.numba-cache .venv/bin/python tests/benchmarks/bench_styl
 
 Prints per frame of a disk translating at 1 px/frame (the exemplar's texture drifts at
 1 px/frame with exact flow): the mean target ext+ increment and flow speed in the
-interior, the mean Δi SHIFTNNF chose, the mean backlog it carried over, the share of
+interior, the mean |Δi| SHIFTNNF chose (forward along ext+, or backward along ext−
+where the rotated flows are opposite), the mean backlog it carried over, the share of
 pixels whose final match is still the shifted one (same frame, within half a pixel),
 how far the final matches moved in source time and space, and the texture's measured
 displacement between consecutive frames (the integer x shift, −2..3 px, that best
@@ -50,7 +51,7 @@ def measure_moving(source, frames, speed, workdir):
     results = list(stylize.stylize_sequence(moving, frames, source, params=scene.FAST, guide_params=scene.GUIDES,
                                             cache_dir=cache_dir))
     target = guides.GuideCache.open(cache_dir)
-    print("frame  ext+inc  |flow|  Δi(shift)  backlog  kept  Δi(final)  Δx(final)  texture-shift")
+    print("frame  ext+inc  |flow|  |Δi|(shift)  backlog  kept  |Δi|(final)  Δx(final)  texture-shift")
     backlog = np.zeros((target.height, target.width), np.float32)
     for previous, current in zip(results, results[1:]):
         k = current.index
@@ -65,8 +66,8 @@ def measure_moving(source, frames, speed, workdir):
         kept = (final.frame == shifted.frame) & (np.abs(final.coords[..., :2] - shifted.coords[..., :2]).max(axis=2) < 0.5)
         print(f"{k:5d}  {(frame.ext_plus - before.ext_plus)[interior].mean():7.3f}  "
               f"{np.linalg.norm(frame.flow, axis=2)[interior].mean():6.3f}  "
-              f"{(shifted.frame - previous.nnf.frame)[interior].mean():9.3f}  {backlog[interior].mean():7.3f}  "
-              f"{kept[interior].mean():4.2f}  {(final.frame - previous.nnf.frame)[interior].mean():9.3f}  "
+              f"{np.abs(shifted.frame - previous.nnf.frame)[interior].mean():11.3f}  {backlog[interior].mean():7.3f}  "
+              f"{kept[interior].mean():4.2f}  {np.abs(final.frame - previous.nnf.frame)[interior].mean():11.3f}  "
               f"{(final.coords[..., 0] - previous.nnf.coords[..., 0])[interior].mean():9.3f}  "
               f"{_texture_shift(previous.rgba[..., :3].mean(axis=2), current.rgba[..., :3].mean(axis=2), interior):13.2f}")
     first, last = results[0].rgba[..., :3], results[-1].rgba[..., :3]
@@ -110,7 +111,8 @@ def main():
                                       cache_dir=Path(workdir) / "source", given_flow=lambda j: flow[j])
         source = stylize.prepare_source(rgb, cache)
         measure_moving(source, args.frames, args.speed, workdir)
-        measure_still(source, args.still_frames, workdir)
+        if args.still_frames > 1:
+            measure_still(source, args.still_frames, workdir)
 
 
 if __name__ == "__main__":
