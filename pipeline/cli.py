@@ -17,7 +17,7 @@ import traceback
 from fluidymation import __version__
 from fluidymation.errors import FluidymationError
 
-COMMANDS = ("check", "masks", "guides", "synth", "exemplar", "render")
+COMMANDS = ("check", "masks", "guides", "synth", "exemplar", "render", "ablate", "cache")
 
 EXIT_USAGE = 2
 EXIT_INTERNAL = 1

@@ -82,6 +82,14 @@ def user_params(plan: Plan, name: str, spec: dict) -> exemplar_user.Params:
         raise SceneError(f"{where}: {exc}") from None
 
 
+def exemplar_identity(plan: Plan, layer: PlannedLayer) -> str:
+    """A key that changes whenever the layer's exemplar would: preset parameters, or recording options and file stamps."""
+    name, spec = exemplar_spec(plan, layer)
+    if spec["kind"] == "builtin":
+        return builtin_params(plan, name, spec).cache_key()
+    return _recording_identity(user_params(plan, name, spec), spec)
+
+
 def layer_source(plan: Plan, layer: PlannedLayer, guide_params: guides.Params, *, progress=None) -> stylize.Source:
     """The layer's exemplar and its guides, generated on first use and cached.
 
@@ -89,17 +97,14 @@ def layer_source(plan: Plan, layer: PlannedLayer, guide_params: guides.Params, *
     """
     name, spec = exemplar_spec(plan, layer)
     if spec["kind"] == "builtin":
-        params = builtin_params(plan, name, spec)
-        exemplar = exemplar_builtin.make_builtin_exemplar(params, cache_dir=paths.exemplar_cache_dir(),
-                                                          progress=progress)
-        rgb, masks, flow, identity = exemplar.rgb, exemplar.mask, exemplar.flow, params.cache_key()
+        exemplar = exemplar_builtin.make_builtin_exemplar(builtin_params(plan, name, spec),
+                                                          cache_dir=paths.exemplar_cache_dir(), progress=progress)
+        rgb, masks, flow = exemplar.rgb, exemplar.mask, exemplar.flow
     else:
-        params = user_params(plan, name, spec)
-        recording = exemplar_user.load_user_exemplar(params)
+        recording = exemplar_user.load_user_exemplar(user_params(plan, name, spec))
         rgb, masks = recording.rgb, recording.mask
         flow = exemplar_user.motion_flow(rgb, seed=spec.get("seed", 0)) if spec.get("flow") == "motion" else None
-        identity = _recording_identity(params, spec)
-    return _with_guides(rgb, masks, flow, identity, guide_params)
+    return _with_guides(rgb, masks, flow, exemplar_identity(plan, layer), guide_params)
 
 
 def _recording_identity(params: exemplar_user.Params, spec: dict) -> str:

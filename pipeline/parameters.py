@@ -21,10 +21,20 @@ from fluidymation.stages import guides, stylize
 GUIDE_NAMES = tuple(field.name for field in dataclasses.fields(guides.Params) if field.name != "scale")
 
 
+def _stylize_config() -> dict:
+    text = resources.files("fluidymation.configs").joinpath("stylize.yaml").read_text(encoding="utf-8")
+    return yaml.safe_load(text)
+
+
 def stylize_defaults() -> dict:
     """The stylize stage's default parameters, from ``configs/stylize.yaml``."""
-    text = resources.files("fluidymation.configs").joinpath("stylize.yaml").read_text(encoding="utf-8")
-    return dict(yaml.safe_load(text)["stylize"])
+    return dict(_stylize_config()["stylize"])
+
+
+def preview_overrides() -> dict:
+    """The quicker schedule ``render --preview`` uses, from ``configs/stylize.yaml``."""
+    return {key: tuple(value) if isinstance(value, list) else value
+            for key, value in _stylize_config()["preview"].items()}
 
 
 def _key_path(plan: Plan, layer: PlannedLayer, key: str) -> str:

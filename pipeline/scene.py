@@ -21,6 +21,7 @@ MAX_FPS = 1000.0
 
 BACKGROUND_TYPES = ("synthesized", "solid", "image")
 BLEND_MODES = ("multiply", "over")
+PREVIEW_FORMATS = ("gif", "webp")
 STYLIZERS = ("fluidymation",)
 EXEMPLAR_KINDS = ("builtin", "video", "images")
 _LAYER_NAME = re.compile(r"^[A-Za-z0-9_][A-Za-z0-9_.\- ]*$")
@@ -48,7 +49,9 @@ class FrameRange:
 class OutputSpec:
     dir: Path
     video: str
-    layers: bool
+    frames: bool = False        # also the composite as frames/00000.png ...
+    preview: str | None = None  # also an animated preview next to the video: "gif" or "webp"
+    crf: int = 18               # H.264 quality: 0 lossless ... 51 worst
 
 
 @dataclass(frozen=True)
@@ -151,12 +154,15 @@ def _size(check: Checker) -> tuple[int, int] | None:
 
 
 def _output(check: Checker, scene_path: Path) -> OutputSpec:
-    check.mapping(("output",), ("dir", "video", "layers"))
+    check.mapping(("output",), ("dir", "video", "frames", "preview", "crf"))
     directory = check.path(("output", "dir"), None) or (check.base_dir / "out" / scene_path.stem).resolve()
     video = check.text(("output", "video"), f"{scene_path.stem}.mp4")
     if Path(video).name != video:
         raise check.error(("output", "video"), "give a file name; the video is written into output.dir")
-    return OutputSpec(dir=directory, video=video, layers=check.boolean(("output", "layers"), True))
+    return OutputSpec(dir=directory, video=video,
+                      frames=check.boolean(("output", "frames"), False),
+                      preview=check.text(("output", "preview"), None, choices=PREVIEW_FORMATS),
+                      crf=check.integer(("output", "crf"), 18, minimum=0, maximum=51))
 
 
 def _background(check: Checker) -> dict:

@@ -86,3 +86,30 @@ def encode_mp4(frames: Iterable[np.ndarray], path: str | os.PathLike, *, params:
 def _chain(first, rest):
     yield first
     yield from rest
+
+
+PREVIEW_WIDTH = 480  # px: animated previews are for quick sharing, not for grading
+
+
+def preview_frame(frame: np.ndarray, *, width: int = PREVIEW_WIDTH) -> np.ndarray:
+    """(H, W, 3) frame as uint8, shrunk by an integer box filter to at most ``width`` px wide."""
+    factor = max(1, -(-frame.shape[1] // width))
+    height, full_width = (frame.shape[0] // factor) * factor, (frame.shape[1] // factor) * factor
+    image = np.asarray(frame[:height, :full_width, :3], np.float32)
+    if factor > 1:
+        image = image.reshape(height // factor, factor, full_width // factor, factor, 3).mean(axis=(1, 3))
+    return to_uint8(image)
+
+
+def write_animation(frames: list[np.ndarray], path: str | os.PathLike, *, fps: float) -> None:
+    """An endlessly looping GIF or WebP (by ``path``'s suffix) of uint8 frames, written atomically."""
+    import imageio.v3 as iio
+
+    path = Path(path)
+    if not frames:
+        raise StageError(f"cannot write {path}: no frames")
+    with atomic_path(path) as tmp:
+        try:
+            iio.imwrite(tmp, np.stack(frames), extension=path.suffix, duration=1000.0 / fps, loop=0)
+        except (OSError, ValueError, TypeError) as exc:
+            raise StageError(f"cannot write the preview {path}: {exc}") from None

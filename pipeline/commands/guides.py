@@ -5,11 +5,9 @@ from __future__ import annotations
 from pathlib import Path
 
 from fluidymation.errors import InputError
-from fluidymation.pipeline.parameters import layer_guide_params
-from fluidymation.pipeline.progress import progress, reporter
-from fluidymation.pipeline.resolve import Plan, PlannedLayer, parse_window, plan_scene
+from fluidymation.pipeline.render import write_layer_guides
+from fluidymation.pipeline.resolve import parse_window, plan_scene
 from fluidymation.pipeline.scene import load_scene
-from fluidymation.stages.guide_views import write_guide_views
 from fluidymation.stages.rasterize import Params as RasterParams
 from fluidymation.stages.rasterize import rasterize_frame
 from fluidymation.stages.vector.svg_input import sequence_files
@@ -47,15 +45,6 @@ def run(args) -> int:
     if not args.quiet:
         print(f"wrote guide views of frames {window.start}:{window.stop} of layer {layer.name} to {out_dir}")
     return 0
-
-
-def write_layer_guides(plan: Plan, layer: PlannedLayer, window: range, coverage, out_dir: Path, *, quiet=False,
-                       raw=False, given_flow=None) -> None:
-    """Guides of ``layer`` over the scene range (masks from ``coverage(index)``), views of ``window`` to ``out_dir``."""
-    with progress(1, f"guides {layer.name}", quiet=quiet, unit="step") as bar:
-        write_guide_views(coverage, plan.frame_count, out_dir, params=layer_guide_params(plan, layer), raw=raw,
-                          given_flow=given_flow, frames=(window.start - plan.start, window.stop - plan.start),
-                          progress=reporter(bar))
 
 
 def given_flows(pattern: str, count: int) -> list[Path]:

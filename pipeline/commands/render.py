@@ -1,47 +1,38 @@
-"""``fluidymation render SCENE --until STAGE``: run the per-layer stages up to STAGE.
-
-Available stages, in order: ``masks`` (writes ``masks/<layer>/*.png``), ``guides``
-(also views of the guidance channels in ``guides/<layer>/``) and ``stylize`` (masks and
-``stylized/<layer>/*.png``, RGBA). Colorize, background, composite and encode do not
-exist yet.
-"""
+"""``fluidymation render SCENE``: the finished film, or the stages up to ``--until``."""
 
 from __future__ import annotations
 
-import tempfile
-from pathlib import Path
-
-import numpy as np
-
 from fluidymation.errors import InputError
-from fluidymation.pipeline.commands.guides import write_layer_guides
-from fluidymation.pipeline.exemplars import layer_source, simulated_frame_count
-from fluidymation.pipeline.parameters import check_layer_params, layer_guide_params, layer_stylize_params
-from fluidymation.pipeline.progress import progress
+from fluidymation.pipeline.render import STAGES, Options, render, scaled_plan
 from fluidymation.pipeline.resolve import parse_window, plan_scene
 from fluidymation.pipeline.scene import load_scene
-from fluidymation.stages.files import write_npy, write_png
-from fluidymation.stages.rasterize import Params as RasterParams
-from fluidymation.stages.rasterize import rasterize_frame
-from fluidymation.stages.stylize import stylize_sequence
 
-STAGES = ("masks", "guides", "stylize")
-PLANNED_STAGES = ("colorize", "background", "composite", "encode")
+PREVIEW_SCALE = 0.5
 
 
 def add_parser(subparsers) -> None:
     parser = subparsers.add_parser(
-        "render", help="render a scene's layers up to a stage (for now: masks, guides or stylize)",
-        description="Run the per-layer stages of a scene up to --until: masks (masks/<layer>/00000.png ...), "
-                    "guides (guides/<layer>/ views), stylize (masks, then stylized/<layer>/00000.png ... RGBA). "
-                    "Files are numbered from the start of the scene's frame range. The later stages "
-                    f"({', '.join(PLANNED_STAGES)}) do not exist yet.")
+        "render", help="render a scene to a video (or up to a stage)",
+        description="Rasterize, stylize and colorize every layer, synthesize the paper, composite the layers "
+                    "in z-order and encode the MP4 into the scene's output.dir, with report.json (timings "
+                    "and cache hits per stage and layer). Work whose inputs and parameters are unchanged is "
+                    "taken from the stage cache (output.dir/.cache). Stages in order: " + ", ".join(STAGES) + ". Frame files are "
+                    "numbered from the start of the scene's frame range.")
     parser.add_argument("scene", help="the scene's YAML file")
-    parser.add_argument("--until", default="stylize", metavar="STAGE",
-                        help=f"last stage to run: {', '.join(STAGES)} (default: stylize); "
-                             f"{', '.join(PLANNED_STAGES)} are not available yet")
-    parser.add_argument("--layer", action="append", metavar="NAME", help="only this layer (repeatable)")
+    parser.add_argument("--until", default=STAGES[-1], metavar="STAGE",
+                        help=f"last stage to run: {', '.join(STAGES)} (default: {STAGES[-1]})")
+    parser.add_argument("--layer", action="append", metavar="NAME",
+                        help="only (re-)render this layer (repeatable); the film is composited with the other "
+                             "layers' earlier results")
     parser.add_argument("--frames", metavar="A:B", help="only scene frames A to B (B exclusive)")
+    parser.add_argument("--scale", type=float, default=1.0, metavar="S",
+                        help="render at S times the scene's size (e.g. 0.5)")
+    parser.add_argument("--preview", action="store_true",
+                        help=f"quick look: {PREVIEW_SCALE:g}x the size and a faster synthesis schedule, "
+                             "into <output.dir>/preview/")
+    parser.add_argument("--force", action="store_true", help="redo every stage, even those the cache holds")
+    parser.add_argument("--force-stage", action="append", default=[], metavar="STAGE",
+                        help="redo this stage even if the cache holds it (repeatable)")
     parser.add_argument("--nnf", action="store_true",
                         help="also save each frame's nearest-neighbour field as stylized/<layer>/nnf/00000.npy "
                              "((H, W, 4) float32: source frame, x, y, θ; frame -1 = no match)")
@@ -49,59 +40,18 @@ def add_parser(subparsers) -> None:
 
 
 def run(args) -> int:
-    if args.until in PLANNED_STAGES:
-        raise InputError(f"--until {args.until}: the {args.until} stage does not exist yet; this version renders "
-                         f"up to {STAGES[-1]} (choose one of {', '.join(STAGES)})")
     if args.until not in STAGES:
         raise InputError(f"--until {args.until!r}: not a stage; choose one of {', '.join(STAGES)}")
+    if not 0 < args.scale <= 8:
+        raise InputError(f"--scale {args.scale:g}: must be above 0 and at most 8")
+    options = Options(until=args.until, layers=tuple(args.layer) if args.layer else None,
+                      window=parse_window(args.frames), preview=args.preview, nnf=args.nnf, quiet=args.quiet,
+                      force=args.force, force_stages=tuple(args.force_stage))
     plan = plan_scene(load_scene(args.scene))
-    window = plan.frames(parse_window(args.frames))
-    layers = [plan.layer(name) for name in args.layer] if args.layer else list(plan.layers)
-    for layer in layers:
-        check_layer_params(plan, layer)
-    raster = RasterParams(size=plan.size, fps=plan.fps)
-    out_dir = plan.scene.output.dir
-    for layer in layers:
-        def coverage(index, layer=layer):
-            return rasterize_frame(plan.source, layer.vector_layers, plan.start + index, raster).coverage
-
-        with progress(len(window), f"masks {layer.name}", quiet=args.quiet) as bar:
-            for frame in window:
-                write_png(out_dir / "masks" / layer.dirname / f"{frame - plan.start:05d}.png",
-                          (coverage(frame - plan.start) > 0.5).astype(np.uint8) * 255)
-                bar.update()
-        if args.until == "guides":
-            write_layer_guides(plan, layer, window, coverage, out_dir / "guides" / layer.dirname, quiet=args.quiet)
-        elif args.until == "stylize":
-            _stylize(plan, layer, window, coverage, args)
+    plan = scaled_plan(plan, args.scale * (PREVIEW_SCALE if args.preview else 1.0))
+    out = render(plan, options)
     if not args.quiet:
-        print(f"rendered {len(layers)} layer(s), frames {window.start}:{window.stop}, up to {args.until}, "
-              f"into {out_dir}")
+        done = out / plan.scene.output.video if args.until == STAGES[-1] else out
+        print(f"rendered {plan.size[0]}x{plan.size[1]}, up to {args.until}: {done}")
     return 0
 
-
-def stylize_layer(plan, layer, window, coverage, out_dir: Path, *, quiet=False, nnf=False, **overrides):
-    """Stylize one layer over a window of scene frames into ``out_dir``; return the files written by index."""
-    guide_params = layer_guide_params(plan, layer)
-    params = layer_stylize_params(plan, layer, **overrides)
-    with progress(simulated_frame_count(plan, layer), f"exemplar for {layer.name}", quiet=quiet) as bar:
-        source = layer_source(plan, layer, guide_params, progress=bar.update)
-    written = {}
-    plan.scene.output.dir.mkdir(parents=True, exist_ok=True)
-    with tempfile.TemporaryDirectory(prefix=".guides-", dir=plan.scene.output.dir) as cache_dir, \
-            progress(len(window), f"stylize {layer.name}", quiet=quiet) as bar:
-        frames = stylize_sequence(coverage, plan.frame_count, source, params=params, guide_params=guide_params,
-                                  cache_dir=cache_dir, frames=(window.start - plan.start, window.stop - plan.start))
-        for result in frames:
-            path = out_dir / f"{result.index:05d}.png"
-            write_png(path, result.rgba)
-            if nnf:
-                write_npy(out_dir / "nnf" / f"{result.index:05d}.npy", result.nnf.as_array())
-            written[result.index] = path
-            bar.update()
-    return written
-
-
-def _stylize(plan, layer, window, coverage, args):
-    stylize_layer(plan, layer, window, coverage, plan.scene.output.dir / "stylized" / layer.dirname,
-                  quiet=args.quiet, nnf=args.nnf)

@@ -1,7 +1,9 @@
 """`fluidymation render --until ...` on a tiny copy of the blob example."""
 
+import json
 from pathlib import Path
 
+import av
 import imageio.v3 as iio
 import numpy as np
 
@@ -33,14 +35,53 @@ def test_render_until_stylize_writes_rgba_frames(cli, tmp_path, monkeypatch):
     assert any((tmp_path / "cache" / "exemplars").iterdir())
 
 
-def test_unknown_parameter_and_later_stages_are_clear_errors(cli, tmp_path, monkeypatch):
+def test_unknown_parameter_and_stage_are_clear_errors(cli, tmp_path, monkeypatch):
     monkeypatch.setenv("FLUIDYMATION_CACHE", str(tmp_path / "cache"))
     code, _, err = cli("render", _scene(tmp_path, params="{w_tmp: 2}"), "--until", "masks")
     assert code == 2 and "defaults.params.w_tmp" in err and "did you mean 'w_temp'" in err and "scene.yaml" in err
-    code, _, err = cli("render", _scene(tmp_path), "--until", "composite")
-    assert code == 2 and "does not exist yet" in err
     code, _, err = cli("render", _scene(tmp_path), "--until", "mask")
-    assert code == 2 and "masks, guides, stylize" in err
+    assert code == 2 and "masks, guides, stylize, colorize, background, composite, encode" in err
+    code, _, err = cli("render", _scene(tmp_path), "--scale", "0")
+    assert code == 2 and "--scale" in err
+
+
+def test_full_render_writes_layers_frames_video_and_report(cli, tmp_path, monkeypatch):
+    monkeypatch.setenv("FLUIDYMATION_CACHE", str(tmp_path / "cache"))
+    scene = _scene(tmp_path)
+    scene.write_text(scene.read_text().replace("output: {dir: out}", "output: {dir: out, preview: gif}")
+                     + "background: {type: solid, color: '#ffffff'}\n")
+    code, out, err = cli("render", scene)
+    assert code == 0, err
+    root = tmp_path / "out"
+    assert "scene.mp4" in out and (root / "scene.mp4").stat().st_size > 0
+    assert iio.imread(root / "scene.gif").shape == (3, 40, 40, 3)
+    layer = iio.imread(root / "layers" / "blob" / "00002.png")
+    assert layer.shape == (40, 40, 4) and layer[..., 3].max() > 0
+    assert (layer[..., 3] == 0).sum() > 0  # outside the blob and on its unpainted paper: transparent
+    report = json.loads((root / "report.json").read_text())
+    stages = [(entry["stage"], entry["layer"]) for entry in report["stages"]]
+    assert stages == [("masks", "blob"), ("stylize", "blob"), ("colorize", "blob"), ("background", None),
+                      ("composite+encode", None)]
+    assert report["frames"] == {"start": 4, "end": 7} and all(e["seconds"] >= 0 for e in report["stages"])
+
+
+def test_preview_renders_half_size_into_its_own_folder(cli, tmp_path, monkeypatch):
+    monkeypatch.setenv("FLUIDYMATION_CACHE", str(tmp_path / "cache"))
+    scene = _scene(tmp_path)
+    scene.write_text(scene.read_text() + "background: {type: solid}\n")
+    code, _, err = cli("-q", "render", scene, "--preview", "--until", "composite")
+    assert code == 0, err
+    frames = sorted((tmp_path / "out" / "preview" / "frames").glob("*.png"))
+    assert len(frames) == 3 and iio.imread(frames[0]).shape == (20, 20, 3)
+    assert not (tmp_path / "out" / "frames").exists()
+
+
+def test_one_layer_cannot_be_composited_before_the_others_exist(cli, tmp_path, monkeypatch):
+    monkeypatch.setenv("FLUIDYMATION_CACHE", str(tmp_path / "cache"))
+    scene = _scene(tmp_path)
+    scene.write_text(scene.read_text() + "  - {name: drop}\nbackground: {type: solid}\n")
+    code, _, err = cli("-q", "render", scene, "--layer", "blob")
+    assert code == 2 and "layer 'drop'" in err and "--layer 'drop'" in err
 
 
 def _recording(folder, frames=5, size=32):
@@ -80,3 +121,21 @@ def test_recorded_exemplar_errors_name_the_key(cli, tmp_path, monkeypatch):
                      "exemplars:\n  rec: {images: 'rec/%02d.png', flow: exact}\ndefaults: {exemplar: rec}\n")
     code, _, err = cli("render", scene, "--until", "stylize")
     assert code == 2 and "exemplars.rec.flow" in err and "built-in" in err
+
+
+def test_ablate_renders_each_term_switched_off_side_by_side(cli, tmp_path, monkeypatch):
+    monkeypatch.setenv("FLUIDYMATION_CACHE", str(tmp_path / "cache"))
+    scene = _scene(tmp_path)
+    code, out, err = cli("ablate", scene, "--layer", "blob", "--frames", "4:6")
+    assert code == 0, err
+    folder = tmp_path / "out" / "ablate" / "blob"
+    variants = sorted(p.name for p in folder.iterdir() if p.is_dir())
+    # w_dir is 0 by default, so "no dir" equals "full" and gets no panel of its own
+    assert variants == ["full", "no-bound", "no-dir-bound", "no-ext", "no-temp", "no-uni"]
+    assert "no dir: the weight is already 0" in out
+    full, no_temp = (iio.imread(folder / name / "00001.png") for name in ("full", "no-temp"))
+    assert not np.array_equal(full, no_temp)
+    with av.open(str(tmp_path / "out" / "ablate" / "blob.mp4")) as container:
+        stream = container.streams.video[0]
+        assert (stream.codec_context.width, stream.codec_context.height) == (6 * 40, 40 + 14)
+        assert sum(1 for _ in container.decode(stream)) == 2

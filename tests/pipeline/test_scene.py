@@ -37,7 +37,7 @@ def test_full_scene(tmp_path):
         frames: {start: 2, end: 10}
         size: [64, 48]
         seed: 7
-        output: {dir: renders, video: b.mp4, layers: false}
+        output: {dir: renders, video: b.mp4, frames: true, preview: webp, crf: 23}
         background: {type: solid, color: "#FAFAF0"}
         exemplars:
           bloom: {builtin: watercolor-bloom, seed: 1}
@@ -53,6 +53,7 @@ def test_full_scene(tmp_path):
         """))
     assert scene.fps == 12.5 and (scene.frames.start, scene.frames.end) == (2, 10)
     assert scene.size == (64, 48) and scene.seed == 7
+    assert (scene.output.frames, scene.output.preview, scene.output.crf) == (True, "webp", 23)
     assert scene.background == {"type": "solid", "color": "#fafaf0"}
     body, sky = scene.layers
     assert body.select == ("body", "arm*") and body.exemplar == "bloom"

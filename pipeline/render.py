@@ -1,0 +1,408 @@
+"""Render a scene: every stage in order, per layer and then for the whole scene.
+
+Per layer: ``masks`` (rasterize; binary masks, soft coverage and the fill colour),
+``guides`` (only as views, with ``--until guides``), ``stylize``, ``colorize``; then for
+the scene: ``background``, ``composite`` and ``encode``. Every stage reads its inputs
+from and writes its products to the output folder (DESIGN.md's output conventions) and
+records them in the stage cache (:mod:`fluidymation.pipeline.cache`), so a later run, or
+a run of a few layers only, redoes only the work whose inputs or parameters changed.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import tempfile
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from fluidymation.errors import SceneError, StageError
+from fluidymation.pipeline.cache import StageCache, file_digest, stage_key
+from fluidymation.pipeline.exemplars import exemplar_identity, layer_source, simulated_frame_count
+from fluidymation.pipeline.parameters import (
+    check_layer_params, layer_guide_params, layer_stylize_params, preview_overrides,
+)
+from fluidymation.pipeline.progress import progress, reporter
+from fluidymation.pipeline.resolve import Plan, PlannedLayer
+from fluidymation.stages import background, colorize, composite, encode, rasterize, stylize
+from fluidymation.stages.colour import parse_hex
+from fluidymation.stages.files import read_image, write_npy, write_png, write_text
+from fluidymation.stages.guide_views import write_guide_views
+
+LAYER_STAGES = ("masks", "guides", "stylize", "colorize")
+SCENE_STAGES = ("background", "composite", "encode")
+STAGES = LAYER_STAGES + SCENE_STAGES
+
+
+@dataclass(frozen=True)
+class Options:
+    """What ``render`` was asked for: the last stage, layers, frames, quality and what to redo."""
+
+    until: str = "encode"
+    layers: tuple[str, ...] | None = None  # None: every layer
+    window: tuple[int | None, int | None] | None = None
+    preview: bool = False
+    nnf: bool = False
+    quiet: bool = False
+    force: bool = False  # redo every stage
+    force_stages: tuple[str, ...] = ()  # redo these stages
+
+
+def scaled_plan(plan: Plan, scale: float) -> Plan:
+    """The plan at ``scale`` times its output size (at least 8 px a side)."""
+    if scale == 1.0:
+        return plan
+    width, height = (max(8, round(side * scale)) for side in plan.size)
+    return dataclasses.replace(plan, size=(width, height))
+
+
+class Report:
+    """Time, frame count and cache hit per stage and layer, written to ``report.json``."""
+
+    def __init__(self, plan: Plan, options: Options):
+        self.started = time.perf_counter()
+        self.entries: list[dict] = []
+        self.header = {"scene": str(plan.scene.path), "size": list(plan.size), "fps": plan.fps,
+                       "frames": {"start": plan.start, "end": plan.end}, "preview": options.preview,
+                       "until": options.until}
+
+    def stage(self, stage: str, layer: str | None, frames: int, started: float, *, cached: bool = False) -> None:
+        self.entries.append({"stage": stage, "layer": layer, "frames": frames, "cached": cached,
+                             "seconds": round(time.perf_counter() - started, 3)})
+
+    def write(self, path: Path) -> None:
+        record = self.header | {"seconds": round(time.perf_counter() - self.started, 3),
+                                "cache_hits": sum(entry["cached"] for entry in self.entries),
+                                "stages": self.entries}
+        write_text(path, json.dumps(record, indent=2) + "\n")
+
+
+def output_dir(plan: Plan, options: Options) -> Path:
+    """Where the render goes: ``output.dir``, or its ``preview/`` subfolder for previews."""
+    return plan.scene.output.dir / "preview" if options.preview else plan.scene.output.dir
+
+
+def render(plan: Plan, options: Options) -> Path:
+    """Run the stages up to ``options.until`` (skipping work the cache holds); return the output folder."""
+    if options.until not in STAGES:
+        raise SceneError(f"--until {options.until!r}: not a stage; choose one of {', '.join(STAGES)}")
+    for stage in options.force_stages:
+        if stage not in STAGES:
+            raise SceneError(f"--force-stage {stage!r}: not a stage; choose one of {', '.join(STAGES)}")
+    chosen = [plan.layer(name) for name in options.layers] if options.layers else list(plan.layers)
+    for layer in chosen:
+        check_layer_params(plan, layer)
+    run = _Run(plan, options)
+    records = {layer.name: run.layer(layer) for layer in chosen}
+    write_layers_summary(plan, records, run.out / "masks", range(plan.start, plan.end))
+    if run.last >= STAGES.index("background"):
+        background_key = run.background()
+        if run.last >= STAGES.index("composite"):
+            run.composite_and_encode(background_key)
+    run.report.write(run.out / "report.json")
+    return run.out
+
+
+class _Run:
+    """One render: the plan, options, output folder, cache and report its stages share."""
+
+    def __init__(self, plan: Plan, options: Options):
+        self.plan, self.options = plan, options
+        self.out = output_dir(plan, options)
+        self.window = plan.frames(options.window)
+        self.last = STAGES.index(options.until)
+        self.cache = StageCache(self.out)
+        self.report = Report(plan, options)
+
+    def _fresh(self, stage: str, layer: str | None, key: str) -> bool:
+        """Whether the cache holds ``stage`` for ``layer`` under ``key`` (and it is not forced)."""
+        forced = self.options.force or stage in self.options.force_stages
+        return not forced and self.cache.hit(stage, layer, key)
+
+    def _frame_span(self) -> list[int]:
+        return [self.window.start - self.plan.start, self.window.stop - self.plan.start]
+
+    def layer(self, layer: PlannedLayer) -> dict:
+        """The per-layer stages; returns the layer's summary record (fill colour, z-order, areas)."""
+        plan, out = self.plan, self.out
+        masks_key = stage_key("masks", rasterize.VERSION, input=input_digest(plan), select=layer.vector_layers,
+                              size=plan.size, fps=plan.fps, start=plan.start, end=plan.end)
+        started = time.perf_counter()
+        if self._fresh("masks", layer.name, masks_key):
+            record = self.cache.lookup("masks", layer.name)["record"]
+            record["color"] = layer.spec.color or record["fill"]
+            self.report.stage("masks", layer.name, plan.frame_count, started, cached=True)
+        else:
+            self.cache.forget("masks", layer.name)
+            with progress(plan.frame_count, f"masks {layer.name}", quiet=self.options.quiet) as bar:
+                record = rasterize_layer(plan, layer, range(plan.start, plan.end), out / "masks" / layer.dirname,
+                                         coverage_dir=out / "coverage" / layer.dirname, bar=bar)
+            files = [out / folder / layer.dirname / f"{k:05d}.png" for folder in ("masks", "coverage")
+                     for k in range(plan.frame_count)]
+            self.cache.commit("masks", layer.name, masks_key, files, record=record)
+            self.report.stage("masks", layer.name, plan.frame_count, started)
+        if self.options.until == "guides":
+            started = time.perf_counter()
+            write_layer_guides(plan, layer, self.window, lambda j: read_coverage(out / "coverage" / layer.dirname, j),
+                               out / "guides" / layer.dirname, quiet=self.options.quiet)
+            self.report.stage("guides", layer.name, len(self.window), started)
+        if self.last >= STAGES.index("stylize"):
+            self._stylize_and_colorize(layer, masks_key, record)
+        return record
+
+    def _stylize_and_colorize(self, layer: PlannedLayer, masks_key: str, record: dict) -> None:
+        plan, out, options = self.plan, self.out, self.options
+        guide_params = layer_guide_params(plan, layer)
+        params = layer_stylize_params(plan, layer, **(preview_overrides() if options.preview else {}))
+        stylize_key = stage_key("stylize", stylize.VERSION, masks=masks_key, exemplar=exemplar_identity(plan, layer),
+                                guides=dataclasses.asdict(guide_params), params=dataclasses.asdict(params),
+                                frames=self._frame_span(), nnf=options.nnf)
+        sources = []
+
+        def source() -> stylize.Source:  # loaded only when a stage has to run
+            if not sources:
+                sources.append(load_layer_source(plan, layer, guide_params, options.quiet))
+            return sources[0]
+
+        started = time.perf_counter()
+        if self._fresh("stylize", layer.name, stylize_key):
+            self.report.stage("stylize", layer.name, len(self.window), started, cached=True)
+        else:
+            self.cache.forget("stylize", layer.name)
+            files = stylize_layer(plan, layer, self.window, source(), params, guide_params,
+                                  coverage_dir=out / "coverage" / layer.dirname,
+                                  out_dir=out / "stylized" / layer.dirname, quiet=options.quiet, nnf=options.nnf)
+            self.cache.commit("stylize", layer.name, stylize_key, files)
+            self.report.stage("stylize", layer.name, len(self.window), started)
+        if self.last < STAGES.index("colorize"):
+            return
+        colorize_params = layer_colorize_params(layer, record["fill"])
+        colorize_key = stage_key("colorize", colorize.VERSION, stylize=stylize_key,
+                                 params=dataclasses.asdict(colorize_params), frames=self._frame_span())
+        started = time.perf_counter()
+        if self._fresh("colorize", layer.name, colorize_key):
+            self.report.stage("colorize", layer.name, len(self.window), started, cached=True)
+            return
+        self.cache.forget("colorize", layer.name)
+        files = colorize_layer(plan, layer, self.window, source(), colorize_params, out, quiet=options.quiet)
+        self.cache.commit("colorize", layer.name, colorize_key, files, frames=self._frame_span())
+        self.report.stage("colorize", layer.name, len(self.window), started)
+
+    def background(self) -> str:
+        """Make (or find in the cache) ``background.png``; return its key."""
+        plan, spec = self.plan, self.plan.scene.background
+        parts = {"spec": spec, "size": plan.size, "seed": plan.scene.seed}
+        if spec.get("path") is not None:
+            parts["file"] = file_digest(spec["path"])
+        elif spec["type"] == "synthesized":
+            parts["exemplar"] = exemplar_identity(plan, _background_layer(plan, spec.get("exemplar")))
+        key = stage_key("background", background.VERSION, **parts)
+        started = time.perf_counter()
+        if self._fresh("background", None, key):
+            self.report.stage("background", None, 1, started, cached=True)
+            return key
+        self.cache.forget("background", None)
+        write_png(self.out / "background.png", make_background(plan, quiet=self.options.quiet))
+        self.cache.commit("background", None, key, [self.out / "background.png"])
+        self.report.stage("background", None, 1, started)
+        return key
+
+    def composite_and_encode(self, background_key: str) -> None:
+        """Composite the layers' colorized frames in z-order over the paper; encode unless stopping at composite."""
+        plan, out, output = self.plan, self.out, self.plan.scene.output
+        ordered = sorted(plan.layers, key=lambda layer: layer.z)
+        layer_keys = []
+        for layer in ordered:
+            manifest = self.cache.lookup("colorize", layer.name)
+            if (manifest is None or manifest.get("frames") != self._frame_span()
+                    or not self.cache.hit("colorize", layer.name, manifest["key"])):
+                raise StageError(f"layer '{layer.name}' has not been colorized for these frames in {out}: render it "
+                                 f"(fluidymation render SCENE --layer '{layer.name}') before compositing")
+            layer_keys.append([manifest["key"], layer.spec.blend, layer.spec.opacity])
+        encode_video = self.last == len(STAGES) - 1
+        stage = "composite+encode" if encode_video else "composite"
+        key = stage_key(stage, composite.VERSION * 1000 + encode.VERSION, layers=layer_keys, background=background_key,
+                        frames=self._frame_span(), fps=plan.fps, output=dataclasses.asdict(output))
+        started = time.perf_counter()
+        if self._fresh(stage, None, key):
+            self.report.stage(stage, None, len(self.window), started, cached=True)
+            return
+        self.cache.forget(stage, None)
+        paper = read_image(out / "background.png", channels=3)
+        files, previews = [], []
+
+        def frames():
+            with progress(len(self.window), "composite", quiet=self.options.quiet) as bar:
+                for frame in self.window:
+                    name = f"{frame - plan.start:05d}.png"
+                    image = composite.composite(paper, [
+                        (read_image(out / "layers" / layer.dirname / name, channels=4), layer.spec.blend,
+                         layer.spec.opacity) for layer in ordered])
+                    if output.frames or not encode_video:
+                        write_png(out / "frames" / name, image)
+                        files.append(out / "frames" / name)
+                    if output.preview and encode_video:
+                        previews.append(encode.preview_frame(image))
+                    bar.update()
+                    yield image
+
+        if encode_video:
+            video = out / output.video
+            encode.encode_mp4(frames(), video, params=encode.Params(fps=plan.fps, crf=output.crf))
+            files.append(video)
+            if output.preview:
+                encode.write_animation(previews, video.with_suffix(f".{output.preview}"), fps=plan.fps)
+                files.append(video.with_suffix(f".{output.preview}"))
+        else:
+            for _ in frames():
+                pass
+        self.cache.commit(stage, None, key, files)
+        self.report.stage(stage, None, len(self.window), started)
+
+
+def input_digest(plan: Plan) -> list[str]:
+    """Content hashes of the scene's vector input (every file of a numbered sequence)."""
+    files = getattr(plan.source, "files", None) or [plan.scene.input]
+    return [file_digest(path) for path in files]
+
+
+def rasterize_layer(plan: Plan, layer: PlannedLayer, frames: range, masks_dir: Path, *,
+                    coverage_dir: Path | None = None, bar=None) -> dict:
+    """Write the layer's masks (0/255; and soft coverage into ``coverage_dir``) for scene ``frames``.
+
+    Files are numbered from the scene's start. ``bar`` is advanced once per frame.
+    Returns the layer's summary record: selection, colour (the scene's, else the fill), the
+    vector file's dominant fill colour, z-order, mask areas.
+    """
+    raster = rasterize.Params(size=plan.size, fps=plan.fps)
+    tally, areas = rasterize.ColorTally(), []
+    for frame in frames:
+        name = f"{frame - plan.start:05d}.png"
+        image = rasterize.rasterize_frame(plan.source, layer.vector_layers, frame, raster)
+        write_png(masks_dir / name, image.mask.astype(np.uint8) * 255)
+        if coverage_dir is not None:
+            write_png(coverage_dir / name, image.coverage)
+        tally.add(image.rgba)
+        areas.append(int(image.mask.sum()))
+        if bar is not None:
+            bar.update()
+    fill = tally.dominant()
+    return {"name": layer.name, "folder": layer.dirname, "select": list(layer.vector_layers),
+            "color": layer.spec.color or fill, "fill": fill, "z": layer.z, "area": areas}
+
+
+def write_layers_summary(plan: Plan, records: dict, masks_dir: Path, frames: range) -> None:
+    """``masks/layers.json``: the layers rasterized (records of other layers from earlier runs kept), in z-order."""
+    path = masks_dir / "layers.json"
+    known = {}
+    if path.is_file():
+        try:
+            known = {item["name"]: item for item in json.loads(path.read_text())["layers"]}
+        except (ValueError, KeyError, TypeError):
+            known = {}
+    names = {layer.name for layer in plan.layers}
+    merged = {name: item for name, item in (known | records).items() if name in names}
+    summary = {"input": str(plan.scene.input), "size": list(plan.size), "fps": plan.fps,
+               "frames": {"start": frames.start, "end": frames.stop, "scene_start": plan.start},
+               "layers": sorted(merged.values(), key=lambda item: item["z"])}
+    write_text(path, json.dumps(summary, indent=2) + "\n")
+
+
+def write_layer_guides(plan: Plan, layer: PlannedLayer, window: range, coverage, out_dir: Path, *, quiet=False,
+                       raw=False, given_flow=None) -> None:
+    """Guides of ``layer`` over the scene range (masks from ``coverage(index)``), views of ``window`` to ``out_dir``."""
+    with progress(1, f"guides {layer.name}", quiet=quiet, unit="step") as bar:
+        write_guide_views(coverage, plan.frame_count, out_dir, params=layer_guide_params(plan, layer), raw=raw,
+                          given_flow=given_flow, frames=(window.start - plan.start, window.stop - plan.start),
+                          progress=reporter(bar))
+
+
+def read_coverage(coverage_dir: Path, index: int) -> np.ndarray:
+    """Frame ``index``'s soft coverage, (H, W) float32, as written by :func:`rasterize_layer`."""
+    return read_image(coverage_dir / f"{index:05d}.png", channels=1)[:, :, 0]
+
+
+def load_layer_source(plan: Plan, layer: PlannedLayer, guide_params, quiet=False) -> stylize.Source:
+    """The layer's exemplar with its guides (generated on first use), with a progress bar."""
+    with progress(simulated_frame_count(plan, layer), f"exemplar for {layer.name}", quiet=quiet) as bar:
+        return layer_source(plan, layer, guide_params, progress=bar.update)
+
+
+def stylize_layer(plan: Plan, layer: PlannedLayer, window: range, source: stylize.Source, params: stylize.Params,
+                  guide_params, *, coverage_dir: Path, out_dir: Path, quiet=False, nnf=False) -> list[Path]:
+    """Stylize a layer's window of scene frames (coverage read from ``coverage_dir``) into ``out_dir``.
+
+    Returns the files written. The target guides live in a temporary folder next to ``out_dir``.
+    """
+    out_dir.mkdir(parents=True, exist_ok=True)
+    written = []
+    with tempfile.TemporaryDirectory(prefix=".guides-", dir=out_dir.parent) as cache_dir, \
+            progress(len(window), f"stylize {layer.name}", quiet=quiet) as bar:
+        frames = stylize.stylize_sequence(
+            lambda j: read_coverage(coverage_dir, j), plan.frame_count, source,
+            params=params, guide_params=guide_params, cache_dir=cache_dir,
+            frames=(window.start - plan.start, window.stop - plan.start))
+        for result in frames:
+            write_png(out_dir / f"{result.index:05d}.png", result.rgba)
+            written.append(out_dir / f"{result.index:05d}.png")
+            if nnf:
+                write_npy(out_dir / "nnf" / f"{result.index:05d}.npy", result.nnf.as_array())
+                written.append(out_dir / "nnf" / f"{result.index:05d}.npy")
+            bar.update()
+    return written
+
+
+def layer_colorize_params(layer: PlannedLayer, fill_color: str | None) -> colorize.Params:
+    """How a layer is colorized: ``colorize: layer`` (its colour or the vector fill), a ``#rrggbb``, or ``none``."""
+    mode = layer.spec.colorize
+    if mode == "none":
+        return colorize.Params(mode="none")
+    hex_color = mode if mode != "layer" else (layer.spec.color or fill_color or "#000000")
+    return colorize.Params(mode="layer", color=tuple(float(c) for c in parse_hex(hex_color)))
+
+
+def colorize_layer(plan: Plan, layer: PlannedLayer, window: range, source: stylize.Source,
+                   params: colorize.Params, out: Path, *, quiet=False) -> list[Path]:
+    """Colorize the layer's stylized frames into ``out/layers/<layer>/``; return the files written."""
+    paper = colorize.estimate_paper(source.rgb, source.segment)
+    unit = colorize.full_density(source.rgb, source.segment, paper)
+    written = []
+    with progress(len(window), f"colorize {layer.name}", quiet=quiet) as bar:
+        for frame in window:
+            name = f"{frame - plan.start:05d}.png"
+            stylized = read_image(out / "stylized" / layer.dirname / name, channels=4)
+            write_png(out / "layers" / layer.dirname / name, colorize.colorize(stylized, paper, unit, params))
+            written.append(out / "layers" / layer.dirname / name)
+            bar.update()
+    return written
+
+
+def make_background(plan: Plan, *, quiet=False) -> np.ndarray:
+    """The scene's static paper, (H, W, 3) sRGB: a solid colour, an image, or synthesized paper."""
+    spec, size = plan.scene.background, plan.size
+    if spec["type"] == "solid":
+        return background.solid(parse_hex(spec["color"]), size)
+    if spec["type"] == "image":
+        return background.image(spec["path"], size)
+    if spec.get("path") is not None:
+        sample = read_image(spec["path"], channels=3)
+    else:
+        layer = _background_layer(plan, spec.get("exemplar"))
+        source = load_layer_source(plan, layer, layer_guide_params(plan, layer), quiet)
+        sample = background.paper_sample(source.rgb, source.segment)
+    with progress(1, "background", quiet=quiet, unit="image"):
+        return background.synthesized(sample, size, seed=plan.scene.seed)
+
+
+def _background_layer(plan: Plan, exemplar: str | None) -> PlannedLayer:
+    """A layer whose exemplar gives the paper: the named exemplar, or the bottom layer's."""
+    bottom = min(plan.layers, key=lambda layer: layer.z)
+    if exemplar is None:
+        return bottom
+    if exemplar not in plan.scene.exemplars:
+        raise SceneError(f"{plan.scene.path}: background.exemplar: no exemplar called '{exemplar}' "
+                         f"(defined: {', '.join(plan.scene.exemplars) or 'none'})")
+    return dataclasses.replace(bottom, spec=dataclasses.replace(bottom.spec, exemplar=exemplar))

@@ -1,0 +1,78 @@
+"""The stage cache: unchanged work is never redone, and a change redoes only what depends on it."""
+
+import json
+from pathlib import Path
+
+ROOT = Path(__file__).parents[2]
+
+SCENE = """\
+version: 1
+input: {input}
+fps: 12
+size: [40, 40]
+frames: {{start: 4, end: 7}}
+output: {{dir: out, video: film.mp4}}
+background: {{type: solid, color: "#f4efe4"}}
+exemplars:
+  ink: {{builtin: watercolor-bloom, size: [32, 32], frames: 6}}
+  dry: {{builtin: watercolor-dry, size: [32, 32], frames: 6}}
+defaults: {{exemplar: ink, params: {{opt_iters: "2, 1", pm_iters: 2}}}}
+layers:
+  - {{name: blob, color: "{blob_color}"}}
+  - {{name: drop, exemplar: {drop_exemplar}}}
+"""
+
+
+def _write(tmp_path, blob_color="#2a6fdb", drop_exemplar="ink"):
+    scene = tmp_path / "scene.yaml"
+    scene.write_text(SCENE.format(input=ROOT / "examples/blob/blob.svg", blob_color=blob_color,
+                                  drop_exemplar=drop_exemplar))
+    return scene
+
+
+def _ran(tmp_path):
+    """The (stage, layer) pairs the last render computed rather than took from the cache."""
+    report = json.loads((tmp_path / "out" / "report.json").read_text())
+    return {(entry["stage"], entry["layer"]) for entry in report["stages"] if not entry["cached"]}, report
+
+
+def test_unchanged_scene_recomputes_nothing(cli, tmp_path, monkeypatch):
+    monkeypatch.setenv("FLUIDYMATION_CACHE", str(tmp_path / "cache"))
+    scene = _write(tmp_path)
+    assert cli("-q", "render", scene)[0] == 0
+    first_ran, first = _ran(tmp_path)
+    video = (tmp_path / "out" / "film.mp4").read_bytes()
+    assert ("stylize", "blob") in first_ran and ("composite+encode", None) in first_ran
+    assert cli("-q", "render", scene)[0] == 0
+    ran, second = _ran(tmp_path)
+    assert ran == set() and second["cache_hits"] == len(second["stages"])
+    assert second["seconds"] < 0.1 * first["seconds"]
+    assert (tmp_path / "out" / "film.mp4").read_bytes() == video
+
+
+def test_a_colour_change_redoes_only_that_layers_colorize_and_the_film(cli, tmp_path, monkeypatch):
+    monkeypatch.setenv("FLUIDYMATION_CACHE", str(tmp_path / "cache"))
+    assert cli("-q", "render", _write(tmp_path))[0] == 0
+    assert cli("-q", "render", _write(tmp_path, blob_color="#d94f30"))[0] == 0
+    ran, _ = _ran(tmp_path)
+    assert ran == {("colorize", "blob"), ("composite+encode", None)}
+
+
+def test_an_exemplar_change_redoes_that_layers_stylize_onwards(cli, tmp_path, monkeypatch):
+    monkeypatch.setenv("FLUIDYMATION_CACHE", str(tmp_path / "cache"))
+    assert cli("-q", "render", _write(tmp_path))[0] == 0
+    assert cli("-q", "render", _write(tmp_path, drop_exemplar="dry"))[0] == 0
+    ran, _ = _ran(tmp_path)
+    assert ran == {("stylize", "drop"), ("colorize", "drop"), ("composite+encode", None)}
+
+
+def test_one_layer_rerendered_and_forced_stages(cli, tmp_path, monkeypatch):
+    monkeypatch.setenv("FLUIDYMATION_CACHE", str(tmp_path / "cache"))
+    scene = _write(tmp_path)
+    assert cli("-q", "render", scene)[0] == 0
+    assert cli("-q", "render", scene, "--layer", "drop", "--force-stage", "stylize")[0] == 0
+    ran, report = _ran(tmp_path)
+    assert ran == {("stylize", "drop")}  # same output, so colorize and the film stay cached
+    assert {entry["layer"] for entry in report["stages"]} == {"drop", None}
+    code, out, _ = cli("cache", "info", scene)
+    assert code == 0 and "stylize" in out and "complete" in out
