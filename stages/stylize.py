@@ -176,12 +176,17 @@ def prepare_source(rgb: np.ndarray, cache: guides.GuideCache) -> Source:
 
 
 class StylizedFrame(NamedTuple):
-    """One synthesized frame: its index in the sequence, RGBA (H, W, 4) float32, the NNF and its mean error."""
+    """One synthesized frame: its index in the sequence, RGBA (H, W, 4) float32, the NNF and its mean error.
+
+    ``backlog`` (H, W) float32 is the motion not yet followed, carried to the next frame;
+    with ``nnf`` it is the state a resumed run needs (``stylize_sequence(resume=...)``).
+    """
 
     index: int
     rgba: np.ndarray
     nnf: NNF
     mean_error: float
+    backlog: np.ndarray
 
 
 def stylize_sequence(
@@ -193,6 +198,7 @@ def stylize_sequence(
     guide_params: guides.Params,
     cache_dir,
     frames: tuple[int, int] | None = None,
+    resume: tuple[int, NNF, np.ndarray] | None = None,
 ) -> Iterator[StylizedFrame]:
     """Stylize a layer's mask sequence; yield each frame as soon as it is done.
 
@@ -212,6 +218,10 @@ def stylize_sequence(
     frames : (first, stop), optional
         Only synthesize sequence frames first..stop−1 (the first one processed starts
         afresh). Default: all.
+    resume : (index, nnf, backlog), optional
+        Continue after the already processed frame ``index`` (one of ``frames``) from its
+        :class:`StylizedFrame` ``nnf`` and ``backlog``; the frames yielded are then exactly
+        those an uninterrupted run yields after ``index``.
 
     Yields
     ------
@@ -224,6 +234,17 @@ def stylize_sequence(
     order = list(range(frame_count - 1, -1, -1)) if params.reverse else list(range(frame_count))
     target = guides.compute_guides(lambda k: masks(order[k]), frame_count, params=guide_params, cache_dir=cache_dir)
     steps = [k for k in range(frame_count) if first <= order[k] < stop]
+    previous = None  # (NNF, inside mask, ext+, motion not yet followed) of the frame processed before
+    if resume is not None:
+        done, resume_nnf, resume_backlog = resume
+        done_steps = [k for k in steps if order[k] == done]
+        if not done_steps:
+            raise StageError(f"stylize: cannot resume after frame {done}, which is not among frames {first}:{stop}")
+        done_frame = target.frame(done_steps[0])
+        done_coverage = _coverage(masks(done), (target.height, target.width), done)
+        previous = (resume_nnf, _inside(done_frame, done_coverage), done_frame.ext_plus,
+                    np.asarray(resume_backlog, np.float32))
+        steps = steps[steps.index(done_steps[0]) + 1:]
     d = max(target.height, target.width)
     synthesis = SynthesisParams(
         patch_size=params.patch_size, pyramid_levels=params.pyramid_levels, search_vote_iters=params.opt_iters,
@@ -246,12 +267,11 @@ def stylize_sequence(
     )
     guide_weights = np.array([params.w_bound, params.w_ext, params.w_ext] + [params.w_temp] * 3, np.float32)
 
-    previous = None  # (NNF, inside mask, ext+, motion not yet followed) of the frame processed before
     for k in steps:
         index = order[k]
         frame = target.frame(k)
         coverage = _coverage(masks(index), (target.height, target.width), index)
-        inside = frame.mask | (coverage > 0)
+        inside = _inside(frame, coverage)
         segment = np.where(inside, np.maximum(frame.segments.astype(np.int32) - 1, 0), -1).astype(np.int32)
         temp = np.zeros((target.height, target.width, 3), np.float32)
         modulation = np.zeros((1, target.height, target.width), np.float32)
@@ -285,7 +305,12 @@ def stylize_sequence(
         )
         rgba = np.concatenate([np.clip(result.image, 0.0, 1.0), coverage[..., None]], axis=2)
         previous = (result.nnf, inside, frame.ext_plus, backlog)
-        yield StylizedFrame(index=index, rgba=rgba, nnf=result.nnf, mean_error=result.mean_error())
+        yield StylizedFrame(index=index, rgba=rgba, nnf=result.nnf, mean_error=result.mean_error(), backlog=backlog)
+
+
+def _inside(frame, coverage: np.ndarray) -> np.ndarray:
+    """Pixels the layer covers in a target frame: its guides' mask or any coverage."""
+    return frame.mask | (coverage > 0)
 
 
 def _coverage(mask, shape, index) -> np.ndarray:
