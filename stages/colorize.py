@@ -4,17 +4,16 @@ The stylized frame shows the exemplar's paint on the exemplar's paper. Dividing 
 paper out (in linear light) gives the paint's transmittance T and its optical density
 D = −ln T, averaged over the channels; D divided by the exemplar's typical density (the
 median over its painted pixels, "density 1") is the pigment density ρ. Beer–Lambert
-then re-renders ρ in the layer colour C (linear c): a layer of density ρ transmits c^ρ.
+then re-renders ρ in the layer colour C (linear c): a layer of density ρ transmits c^ρ,
+from 1 (paper, ρ = 0) through exactly C (ρ = 1) to darker than C (ρ > 1: watercolor's
+dark rims and pools). Mode ``"none"`` keeps the exemplar's own colours instead: the
+transmittance is T itself, the paint without the exemplar's paper, so the scene's
+background shows through rather than two papers on top of each other.
+
 The output is a straight-alpha RGBA layer that, composited over white paper in linear
-light, gives
-
-* ρ ≤ 1: the glaze ρ·c + (1 − ρ), from transparent (paper) to exactly C;
-* ρ > 1: c^ρ, darker than C (watercolor's dark rims and pools).
-
-Mode ``"none"`` keeps the exemplar's own colours instead: composited over white it
-gives back T, the paint without the exemplar's paper, so the scene's background shows
-through rather than two papers on top of each other. Its alpha is min(ρ, 1), raised to
-1 − min(T) where a channel is darker than such a glaze can reach.
+light, gives back that transmittance exactly, and multiplied onto any paper multiplies
+by it. Its alpha is min(ρ, 1), raised to 1 − min(transmittance) where a channel is
+darker than a glaze of that alpha can reach, so paper (ρ = 0) is transparent.
 """
 
 from __future__ import annotations
@@ -27,7 +26,7 @@ from fluidymation.errors import StageError
 from fluidymation.stages.colour import as_srgb, linear_to_srgb, srgb_to_linear
 
 NAME = "colorize"
-VERSION = 1
+VERSION = 2
 
 MODES = ("layer", "none")
 
@@ -145,16 +144,14 @@ def colorize(rgba: np.ndarray, paper, density_unit: float, params: Params) -> np
     paper = _paper_colour(paper)
     rgb, coverage = rgba[:, :, :3], rgba[:, :, 3]
     density = np.clip(_optical_density(rgb, paper) / np.float32(density_unit), 0.0, params.max_density)
-    glaze = np.minimum(density, 1.0)[:, :, None]
     if params.mode == "layer":
-        colour = srgb_to_linear(np.asarray(params.color, dtype=np.float32))
-        linear = colour ** np.maximum(density, 1.0)[:, :, None]
+        transmittance = srgb_to_linear(np.asarray(params.color, dtype=np.float32)) ** density[:, :, None]
     else:
         transmittance = _transmittance(rgb, paper, floor=0.0)
-        # a glaze of alpha a reaches at most 1 − a: raise a where a channel is darker
-        glaze = np.maximum(glaze, 1.0 - transmittance.min(axis=2, keepdims=True))
-        with np.errstate(divide="ignore", invalid="ignore"):
-            linear = np.where(glaze > 0, np.clip((transmittance - (1.0 - glaze)) / glaze, 0.0, 1.0), 0.0)
+    # alpha min(ρ, 1), raised where a channel is darker than a glaze of that alpha can reach (1 − a)
+    glaze = np.maximum(np.minimum(density, 1.0)[:, :, None], 1.0 - transmittance.min(axis=2, keepdims=True))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        linear = np.where(glaze > 0, np.clip((transmittance - (1.0 - glaze)) / glaze, 0.0, 1.0), 0.0)
     out = np.empty_like(rgba)
     out[:, :, :3] = linear_to_srgb(linear)
     out[:, :, 3] = coverage * glaze[:, :, 0]

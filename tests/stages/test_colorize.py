@@ -72,15 +72,17 @@ def test_density_one_reproduces_the_layer_colour_on_white(colour):
     np.testing.assert_allclose(over, _over_white(out), atol=1e-5)
 
 
-def test_paper_is_transparent_and_lighter_densities_are_glazes():
+def test_paper_is_transparent_and_lighter_densities_are_beer_lambert():
     paper = PAPER
     pixels = _frame(_with_density([0.0, 0.3, 0.6]))
     pixels[0, 0, :3] = paper
     out = cz.colorize(pixels, paper, 0.6, cz.Params(color="#2a6fdb"))
-    np.testing.assert_allclose(out[0, :, 3], [0.0, 0.5, 1.0], atol=1e-4)
     colour = srgb_to_linear(parse_hex("#2a6fdb"))
+    np.testing.assert_allclose(out[0, :, 3], [0.0, max(0.5, 1 - (colour**0.5).min()), 1.0], atol=1e-4)
     shown = srgb_to_linear(_over_white(out))[0]
-    np.testing.assert_allclose(shown[1], 0.5 * colour + 0.5, atol=2e-3)
+    np.testing.assert_allclose(shown[0], 1.0, atol=1e-6)
+    np.testing.assert_allclose(shown[1], colour**0.5, atol=2e-3)
+    np.testing.assert_allclose(shown[2], colour, atol=2e-3)
     lighter_than_paper = _frame(np.minimum(paper + 0.03, 1.0)[None, None])
     assert cz.colorize(lighter_than_paper, paper, 0.6, cz.Params(color="#2a6fdb"))[0, 0, 3] == 0.0
 
@@ -89,7 +91,8 @@ def test_alpha_is_coverage_times_glaze():
     pixels = _frame(_with_density([0.6, 0.6]))
     pixels[0, :, 3] = [0.25, 1.0]
     out = cz.colorize(pixels, PAPER, 1.2, cz.Params(color="#d94f30"))
-    np.testing.assert_allclose(out[0, :, 3], [0.125, 0.5], atol=1e-4)
+    glaze = max(0.5, 1 - (srgb_to_linear(parse_hex("#d94f30")) ** 0.5).min())
+    np.testing.assert_allclose(out[0, :, 3], [0.25 * glaze, glaze], atol=1e-4)
 
 
 def test_denser_paint_is_darker_beer_lambert():
