@@ -99,7 +99,7 @@ def _patch_cost(
     if use_opposite:
         centre_angle = source_angle[frame, int(y + 0.5), int(x + 0.5)]
         opposite = math.cos(centre_angle + theta - target_angle[ty, tx]) < 0.0
-    total = np.float32(0.0)
+    total = 0.0  # float64: the sums of earlier versions, bit for bit
     sx = int(x)
     sy = int(y)
     if (
@@ -137,8 +137,33 @@ def _patch_cost(
             if total > bound:
                 return total
         return total
-    cos_t = math.cos(theta)
-    sin_t = math.sin(theta)
+    return _rotated_cost(
+        source_rows, target_rows, feature_weights, feature_start, plain_end, group_ends, weight_maps, opposite_feature,
+        opposite, source_angle, target_angle, orientation_weight, orientation_clamp, source_height, source_width, radius,
+        tx, ty, frame, x, y, theta, bound,
+    )
+
+
+@kernel
+def _rotated_cost(
+    source_rows, target_rows, feature_weights, feature_start, plain_end, group_ends, weight_maps, opposite_feature,
+    opposite, source_angle, target_angle, orientation_weight, orientation_clamp, source_height, source_width, radius,
+    tx, ty, frame, x, y, theta, bound,
+):
+    """The cost of a rotated or fractional candidate: bilinear samples, in float32, on the
+    row views; it stops as soon as the partial sum exceeds ``bound`` (most random
+    candidates are refused within the first few pixels)."""
+    features = feature_weights.shape[0]
+    height = target_rows.shape[0]
+    width = target_rows.shape[1] // features
+    groups = group_ends.shape[0]
+    cos_t = np.float32(math.cos(theta))
+    sin_t = np.float32(math.sin(theta))
+    high_x = np.float32(source_width - 1)
+    high_y = np.float32(source_height - 1)
+    one = np.float32(1.0)
+    frame_row = frame * source_height
+    total = np.float32(0.0)
     for dy in range(-radius, radius + 1):
         qy = ty + dy
         if qy < 0 or qy >= height:
@@ -147,9 +172,21 @@ def _patch_cost(
             qx = tx + dx
             if qx < 0 or qx >= width:
                 continue
-            sample_x = x + cos_t * dx - sin_t * dy
-            sample_y = y + sin_t * dx + cos_t * dy
-            x0, y0, x1, y1, w00, w10, w01, w11 = _bilinear_setup(sample_x, sample_y, source_height, source_width)
+            sample_x = min(max(x + cos_t * np.float32(dx) - sin_t * np.float32(dy), np.float32(0.0)), high_x)
+            sample_y = min(max(y + sin_t * np.float32(dx) + cos_t * np.float32(dy), np.float32(0.0)), high_y)
+            x0 = int(sample_x)
+            y0 = int(sample_y)
+            fx = sample_x - np.float32(x0)
+            fy = sample_y - np.float32(y0)
+            w00 = (one - fx) * (one - fy)
+            w10 = fx * (one - fy)
+            w01 = (one - fx) * fy
+            w11 = fx * fy
+            row0 = frame_row + y0
+            row1 = frame_row + min(y0 + 1, source_height - 1)
+            column0 = x0 * features
+            column1 = min(x0 + 1, source_width - 1) * features
+            target_column = qx * features
             start = feature_start
             for g in range(-1, groups):
                 end = plain_end if g < 0 else group_ends[g]
@@ -157,22 +194,22 @@ def _patch_cost(
                 for c in range(start, end):
                     sc = opposite_feature[c] if opposite else c
                     value = (
-                        w00 * source[frame, y0, x0, sc]
-                        + w10 * source[frame, y0, x1, sc]
-                        + w01 * source[frame, y1, x0, sc]
-                        + w11 * source[frame, y1, x1, sc]
+                        w00 * np.float32(source_rows[row0, column0 + sc])
+                        + w10 * np.float32(source_rows[row0, column1 + sc])
+                        + w01 * np.float32(source_rows[row1, column0 + sc])
+                        + w11 * np.float32(source_rows[row1, column1 + sc])
                     )
-                    d = value - np.float32(target[qy, qx, c])
+                    d = value - np.float32(target_rows[qy, target_column + c])
                     part += feature_weights[c] * d * d
                 total += part if g < 0 else weight_maps[g, qy, qx] * part
                 start = max(end, feature_start)
             if orientation_weight > 0.0:
-                nearest_x = int(min(max(sample_x + 0.5, 0.0), source_width - 1.0))
-                nearest_y = int(min(max(sample_y + 0.5, 0.0), source_height - 1.0))
+                nearest_x = int(sample_x + np.float32(0.5))
+                nearest_y = int(sample_y + np.float32(0.5))
                 turn = source_angle[frame, nearest_y, nearest_x] + theta - target_angle[qy, qx]
                 total += orientation_weight * min(abs(math.tan(turn)), orientation_clamp)
-        if total > bound:
-            return total
+            if total > bound:
+                return total
     return total
 
 

@@ -13,6 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from fluidymation.engine._jit import threads_for
 from fluidymation.engine.nnf import (
     NNF, ROTATION_FLOW, ROTATION_NONE, downscale_nnf, fill_random, merge_nnf, segment_index, upscale_nnf,
 )
@@ -400,77 +401,80 @@ def _synthesize(source, target, params, target_guides):
     for rank, level in enumerate(range(levels - 1, -1, -1)):
         prepared = source.levels[level]
         level_height, level_width = target_guides[level].shape[:2]
-        level_source_shape = prepared.colour.shape[1:3]
-        cost = target_patch_cost(
-            prepared.features, target_colour=np.zeros((level_height, level_width, colours), np.float32),
-            target_guides=target_guides[level], colour_weights=target.colour_weights,
-            guide_weights=target.guide_weights, weight_maps=weight_maps[level], source_angle=prepared.angle,
-            target_angle=target_angle[level], orientation_weight=params.orientation_weight,
-            orientation_clamp=params.orientation_clamp, source_segment=prepared.segment,
-            target_segment=target_segments[level], patch_size=params.patch_size,
-        )
-
-        def repair(field, salt):
-            fill_random(
-                field, target_segment=cost.target_segment, source_segment=cost.source_segment, seed=params.seed, salt=salt, replace_all=False,
-                rotation_mode=rotation_mode, target_angle=target_angle[level], source_angle=prepared.angle,
-                index=prepared.index,
+        with threads_for(level_height * level_width):
+            level_source_shape = prepared.colour.shape[1:3]
+            cost = target_patch_cost(
+                prepared.features, target_colour=np.zeros((level_height, level_width, colours), np.float32),
+                target_guides=target_guides[level], colour_weights=target.colour_weights,
+                guide_weights=target.guide_weights, weight_maps=weight_maps[level], source_angle=prepared.angle,
+                target_angle=target_angle[level], orientation_weight=params.orientation_weight,
+                orientation_clamp=params.orientation_clamp, source_segment=prepared.segment,
+                target_segment=target_segments[level], patch_size=params.patch_size,
             )
 
-        def revote():
-            colour, _ = vote(prepared.colour, nnf, patch_size=params.patch_size)
-            cost.set_target_colour(colour)
-            return colour
+            def repair(field, salt):
+                fill_random(
+                    field, target_segment=cost.target_segment, source_segment=cost.source_segment, seed=params.seed, salt=salt, replace_all=False,
+                    rotation_mode=rotation_mode, target_angle=target_angle[level], source_angle=prepared.angle,
+                    index=prepared.index,
+                )
 
-        def downscaled_initial():
-            field = downscale_nnf(target.initial_nnf, steps=level, target_shape=(level_height, level_width),
-                                  source_shape=level_source_shape)
-            repair(field, _salt(level, 1, 0, 0))
-            return field
+            def revote():
+                colour, _ = vote(prepared.colour, nnf, patch_size=params.patch_size)
+                cost.set_target_colour(colour)
+                return colour
 
-        random_start = nnf is None and target.initial_nnf is None
-        if nnf is None:
-            nnf = downscaled_initial() if target.initial_nnf is not None else NNF.empty(level_height, level_width)
-            repair(nnf, _salt(level, 0, 0, 0))
-        else:
-            nnf = upscale_nnf(nnf, target_shape=(level_height, level_width), source_shape=level_source_shape)
-            repair(nnf, _salt(level, 0, 0, 0))
-            if target.initial_nnf is not None:
-                revote()
-                other = downscaled_initial()
-                nnf, _ = merge_nnf(nnf, other, patch_errors(cost, nnf), patch_errors(cost, other))
-        colour = revote()
+            def downscaled_initial():
+                field = downscale_nnf(target.initial_nnf, steps=level, target_shape=(level_height, level_width),
+                                      source_shape=level_source_shape)
+                repair(field, _salt(level, 1, 0, 0))
+                return field
 
-        if random_start and params.guided_initialization:
-            guides_cost = cost.guides_only()
-            error = patch_errors(guides_cost, nnf)
-            for iteration in range(_schedule(params.patchmatch_iters, rank)):
-                patchmatch_pass(guides_cost, nnf, error, rotation_mode=rotation_mode, alpha=params.alpha,
-                                seed=params.seed, salt=_salt(level, 2, 0, iteration), reverse=iteration % 2 == 1,
-                                tile_rows=params.tile_rows)
+            random_start = nnf is None and target.initial_nnf is None
+            if nnf is None:
+                nnf = downscaled_initial() if target.initial_nnf is not None else NNF.empty(level_height, level_width)
+                repair(nnf, _salt(level, 0, 0, 0))
+            else:
+                nnf = upscale_nnf(nnf, target_shape=(level_height, level_width), source_shape=level_source_shape)
+                repair(nnf, _salt(level, 0, 0, 0))
+                if target.initial_nnf is not None:
+                    revote()
+                    other = downscaled_initial()
+                    nnf, _ = merge_nnf(nnf, other, patch_errors(cost, nnf), patch_errors(cost, other))
             colour = revote()
 
-        if level == 0 and levels > 1 and params.vote_only_finest:
-            break
-        scales = None
-        if params.uniformity_weight > 0:
-            scales = budget_scales(source_segment=cost.source_segment, target_segment=cost.target_segment,
-                                   patch_size=params.patch_size, frame_radius=params.uniformity_radius,
-                                   weight=params.uniformity_weight)
-        for em in range(_schedule(params.search_vote_iters, rank)):
-            error = patch_errors(cost, nnf)
-            for iteration in range(_schedule(params.patchmatch_iters, rank)):
-                penalty = None
-                if scales is not None:
-                    occurrence = occurrence_map(nnf, source_shape=cost.source_segment.shape,
-                                                patch_size=params.patch_size, frame_radius=params.uniformity_radius)
-                    penalty = uniformity_penalty(occurrence, source_segment=cost.source_segment, scales=scales,
-                                                 patch_size=params.patch_size)
-                patchmatch_pass(cost, nnf, error, penalty=penalty, rotation_mode=rotation_mode, alpha=params.alpha,
-                                seed=params.seed, salt=_salt(level, 3, em, iteration), reverse=iteration % 2 == 1,
-                                tile_rows=params.tile_rows)
-            colour = revote()
-    return SynthesisResult(image=colour, nnf=nnf, error=patch_errors(cost, nnf))
+            if random_start and params.guided_initialization:
+                guides_cost = cost.guides_only()
+                error = patch_errors(guides_cost, nnf)
+                for iteration in range(_schedule(params.patchmatch_iters, rank)):
+                    patchmatch_pass(guides_cost, nnf, error, rotation_mode=rotation_mode, alpha=params.alpha,
+                                    seed=params.seed, salt=_salt(level, 2, 0, iteration), reverse=iteration % 2 == 1,
+                                    tile_rows=params.tile_rows)
+                colour = revote()
+
+            if level == 0 and levels > 1 and params.vote_only_finest:
+                break
+            scales = None
+            if params.uniformity_weight > 0:
+                scales = budget_scales(source_segment=cost.source_segment, target_segment=cost.target_segment,
+                                       patch_size=params.patch_size, frame_radius=params.uniformity_radius,
+                                       weight=params.uniformity_weight)
+            for em in range(_schedule(params.search_vote_iters, rank)):
+                error = patch_errors(cost, nnf)
+                for iteration in range(_schedule(params.patchmatch_iters, rank)):
+                    penalty = None
+                    if scales is not None:
+                        occurrence = occurrence_map(nnf, source_shape=cost.source_segment.shape,
+                                                    patch_size=params.patch_size, frame_radius=params.uniformity_radius)
+                        penalty = uniformity_penalty(occurrence, source_segment=cost.source_segment, scales=scales,
+                                                     patch_size=params.patch_size)
+                    patchmatch_pass(cost, nnf, error, penalty=penalty, rotation_mode=rotation_mode, alpha=params.alpha,
+                                    seed=params.seed, salt=_salt(level, 3, em, iteration), reverse=iteration % 2 == 1,
+                                    tile_rows=params.tile_rows)
+                colour = revote()
+    with threads_for(height * width):
+        error = patch_errors(cost, nnf)
+    return SynthesisResult(image=colour, nnf=nnf, error=error)
 
 
 def _salt(level, phase, em, iteration):

@@ -36,26 +36,41 @@ def _bucket_by_frame(nnf_frame, frames):
 
 
 @parallel_kernel
-def _occurrence(nnf_frame, nnf_coords, offsets, indices, patch_radius, frame_radius, out):
+def _stamp(nnf_frame, nnf_coords, offsets, indices, patch_radius, out):
+    """Count the footprints of the patches matched in each frame, in that frame only."""
     frames, height, width = out.shape
     target_width = nnf_frame.shape[1]
     for frame in prange(frames):
         out[frame] = 0
-        for source_frame in range(max(0, frame - frame_radius), min(frames, frame + frame_radius + 1)):
-            for k in range(offsets[source_frame], offsets[source_frame + 1]):
-                ty = indices[k] // target_width
-                tx = indices[k] % target_width
-                x = nnf_coords[ty, tx, 0]
-                y = nnf_coords[ty, tx, 1]
-                theta = nnf_coords[ty, tx, 2]
-                cos_t = math.cos(theta)
-                sin_t = math.sin(theta)
-                for dy in range(-patch_radius, patch_radius + 1):
-                    for dx in range(-patch_radius, patch_radius + 1):
-                        px = int(math.floor(x + cos_t * dx - sin_t * dy + 0.5))
-                        py = int(math.floor(y + sin_t * dx + cos_t * dy + 0.5))
-                        if 0 <= px < width and 0 <= py < height:
-                            out[frame, py, px] += 1
+        for k in range(offsets[frame], offsets[frame + 1]):
+            ty = indices[k] // target_width
+            tx = indices[k] % target_width
+            x = nnf_coords[ty, tx, 0]
+            y = nnf_coords[ty, tx, 1]
+            theta = nnf_coords[ty, tx, 2]
+            cos_t = math.cos(theta)
+            sin_t = math.sin(theta)
+            for dy in range(-patch_radius, patch_radius + 1):
+                for dx in range(-patch_radius, patch_radius + 1):
+                    px = int(math.floor(x + cos_t * dx - sin_t * dy + 0.5))
+                    py = int(math.floor(y + sin_t * dx + cos_t * dy + 0.5))
+                    if 0 <= px < width and 0 <= py < height:
+                        out[frame, py, px] += 1
+
+
+@parallel_kernel
+def _sum_frames(counts, frame_radius, out):
+    """``out[i] = Σ counts[i − r .. i + r]`` (frames outside the sequence count 0)."""
+    frames, height, width = counts.shape
+    for y in prange(height):
+        running = np.zeros(width, np.int32)
+        for frame in range(-frame_radius, frames + frame_radius):
+            if frame + frame_radius < frames:
+                running += counts[frame + frame_radius, y]
+            if frame - frame_radius - 1 >= 0:
+                running -= counts[frame - frame_radius - 1, y]
+            if 0 <= frame < frames:
+                out[frame, y] = running
 
 
 def occurrence_map(nnf, *, source_shape, patch_size, frame_radius=0):
@@ -75,9 +90,13 @@ def occurrence_map(nnf, *, source_shape, patch_size, frame_radius=0):
     ndarray, shape (T, Hs, Ws), int32
     """
     frames = int(source_shape[0])
-    out = np.empty(tuple(int(s) for s in source_shape), np.int32)
+    counts = np.empty(tuple(int(s) for s in source_shape), np.int32)
     offsets, indices = _bucket_by_frame(nnf.frame, frames)
-    _occurrence(nnf.frame, nnf.coords, offsets, indices, patch_size // 2, int(frame_radius), out)
+    _stamp(nnf.frame, nnf.coords, offsets, indices, patch_size // 2, counts)
+    if frame_radius == 0:
+        return counts
+    out = np.empty_like(counts)
+    _sum_frames(counts, int(frame_radius), out)
     return out
 
 

@@ -1,0 +1,192 @@
+"""Benchmark: the stylize stage at the sizes of issue 6, next to the paper's Table 2.
+
+Run: ``.venv/bin/python tests/benchmarks/bench_stylize.py [--cases speed memory] [--threads 2]
+[--profile]``.
+
+* speed: a 500×600 target with ~60 000 masked pixels (an ellipse drifting and turning)
+  for 6 frames, the built-in ``watercolor-bloom`` at 200×200×20 as exemplar — the size of
+  the paper's "sunflower" row (1.33 s/frame in C++ on 4 cores at 3 GHz). Target: ≤ 1.3
+  s/frame on 2 cores.
+* memory: a 1000×800 target (a wobbling blob) for 40 frames with a 400×222×20 exemplar
+  — the thesis's horse (about 9 GiB there). Target: peak RSS < 1 GiB, flat per frame.
+
+Each case runs in its own process with ``NUMBA_NUM_THREADS`` threads. A tiny warm-up
+scene first loads (or compiles) numba's kernels; its time is shown as "warm-up". The
+target guides are computed before timing (the stage reads them from its cache), so a
+frame's time is synthesis only. Parameters are configs/stylize.yaml's; exemplars are
+taken from (or generated into) the user cache. ``--profile`` prints the child's cProfile.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+PAPER_SECONDS_PER_FRAME = 1.33
+CASES = {
+    # name: target (width, height), frames, exemplar (width, height, frames), shape
+    "speed": ((500, 600), 6, (200, 200, 20), "ellipse"),
+    "memory": ((1000, 800), 40, (400, 222, 20), "blob"),
+}
+RSS_EVERY = 10
+
+
+def ellipse_masks(width, height, axes=(160.0, 120.0)):
+    """An ellipse (by default of ~60 000 px) drifting (3, 2) px/frame and turning."""
+    yy, xx = np.mgrid[:height, :width].astype(np.float32) + 0.5
+
+    def mask(index):
+        cx, cy = width / 2 - 3.0 * index, height / 2 - 2.0 * index
+        turn = 0.02 * index
+        u = (xx - cx) * np.cos(turn) + (yy - cy) * np.sin(turn)
+        v = -(xx - cx) * np.sin(turn) + (yy - cy) * np.cos(turn)
+        return (u / axes[0]) ** 2 + (v / axes[1]) ** 2 < 1.0
+
+    return mask
+
+
+def blob_masks(width, height):
+    """A wobbling blob of ~150 000 px moving a few px per frame (as bench_guides.py's)."""
+    yy, xx = np.mgrid[:height, :width].astype(np.float32)
+
+    def mask(index):
+        t = index / 24.0
+        cx = width / 2 + 180 * np.sin(t)
+        cy = height / 2 + 60 * np.cos(1.3 * t)
+        angle = np.arctan2(yy - cy, xx - cx)
+        radius = 220 + 40 * np.sin(3 * angle + t) + 30 * np.sin(t / 2)
+        return np.hypot(xx - cx, yy - cy) < radius
+
+    return mask
+
+
+def peak_and_current_rss_mib():
+    """(VmHWM, VmRSS) of this process in MiB, from /proc/self/status."""
+    fields = {}
+    for line in Path("/proc/self/status").read_text().splitlines():
+        key, _, value = line.partition(":")
+        if key in ("VmHWM", "VmRSS"):
+            fields[key] = int(value.split()[0]) / 1024.0
+    return fields["VmHWM"], fields["VmRSS"]
+
+
+def exemplar_source(width, height, frames, guide_params, folder):
+    """The built-in ``watercolor-bloom`` at this size with its guides, as a stylize Source."""
+    from fluidymation.pipeline import paths
+    from fluidymation.pipeline.presets import resolve_params
+    from fluidymation.stages import exemplar_builtin, guides, stylize
+
+    params = resolve_params("watercolor-bloom", size=(width, height), frames=frames)
+    exemplar = exemplar_builtin.make_builtin_exemplar(params, cache_dir=paths.exemplar_cache_dir())
+    cache = guides.compute_guides(lambda j: exemplar.mask[j], frames, params=guide_params, cache_dir=folder,
+                                  given_flow=lambda j: exemplar.flow[j])
+    return stylize.prepare_source(exemplar.rgb, cache)
+
+
+def run_case(name, profile):
+    """Child process: run one case, print one JSON line with its figures."""
+    from fluidymation.pipeline.parameters import stylize_defaults
+    from fluidymation.stages import guides, stylize
+
+    (width, height), frame_count, (ex_width, ex_height, ex_frames), shape = CASES[name]
+    params = stylize.Params(**stylize_defaults())
+    guide_params = guides.Params()
+    masks = (ellipse_masks if shape == "ellipse" else blob_masks)(width, height)
+    with tempfile.TemporaryDirectory() as folder:
+        folder = Path(folder)
+        started = time.perf_counter()
+        small = exemplar_source(48, 48, 6, guide_params, folder / "warm-source")
+        for _ in stylize.stylize_sequence(ellipse_masks(64, 64, (20.0, 15.0)), 2, small,
+                                          params=params, guide_params=guide_params, cache_dir=folder / "warm"):
+            pass
+        warm_up = time.perf_counter() - started
+        source = exemplar_source(ex_width, ex_height, ex_frames, guide_params, folder / "source")
+        packed = [np.packbits(masks(j)) for j in range(frame_count)]
+        masked = [int(masks(j).sum()) for j in range(frame_count)]
+
+        def mask(j):
+            return np.unpackbits(packed[j], count=width * height).reshape(height, width).view(bool)
+
+        started = time.perf_counter()
+        guides.compute_guides(mask, frame_count, params=guide_params, cache_dir=folder / "target")
+        guide_seconds = time.perf_counter() - started
+        rss = [("before", *peak_and_current_rss_mib())]
+        times = []
+        profiler = None
+        if profile:
+            import cProfile
+
+            profiler = cProfile.Profile()
+            profiler.enable()
+        loads = [os.getloadavg()[0]]
+        started = time.perf_counter()
+        for done, _ in enumerate(stylize.stylize_sequence(mask, frame_count, source, params=params,
+                                                          guide_params=guide_params, cache_dir=folder / "target"),
+                                 start=1):
+            times.append(time.perf_counter() - started)
+            started = time.perf_counter()
+            if done % RSS_EVERY == 0:
+                rss.append((f"frame {done}", *peak_and_current_rss_mib()))
+        loads.append(os.getloadavg()[0])
+        if profiler is not None:
+            import pstats
+
+            profiler.disable()
+            pstats.Stats(profiler, stream=sys.stderr).sort_stats("cumulative").print_stats(30)
+    print(json.dumps({"warm_up": warm_up, "guides": guide_seconds, "times": times, "masked": masked, "rss": rss,
+                      "peak": peak_and_current_rss_mib()[0], "loads": loads}))
+
+
+def run_child(name, threads, profile):
+    env = dict(os.environ, NUMBA_NUM_THREADS=str(threads))
+    command = [sys.executable, __file__, "--child", name] + (["--profile"] if profile else [])
+    result = subprocess.run(command, env=env, stdout=subprocess.PIPE, text=True)
+    if result.returncode != 0:
+        raise SystemExit(f"case {name} failed ({result.returncode})")
+    return json.loads(result.stdout.strip().splitlines()[-1])
+
+
+def report(name, figures, threads):
+    (width, height), frame_count, (ex_width, ex_height, ex_frames), _ = CASES[name]
+    times = np.array(figures["times"])
+    masked = np.array(figures["masked"], np.float64)
+    later = times[1:] if len(times) > 1 else times
+    print(f"\n{name}: target {width}x{height} px, {frame_count} frames, {masked.mean():.0f} masked px/frame; "
+          f"exemplar {ex_width}x{ex_height}x{ex_frames}; {threads} threads; load average "
+          f"{figures['loads'][0]:.2f} -> {figures['loads'][1]:.2f}")
+    print(f"  warm-up (numba load/compile, tiny scene) {figures['warm_up']:.1f} s; "
+          f"target guides {figures['guides']:.1f} s ({figures['guides'] / frame_count:.2f} s/frame)")
+    print(f"  {'':24s} {'s/frame':>8s} {'µs/px/frame':>12s} {'paper s/frame':>14s}")
+    rows = (("first frame", times[:1], masked[:1]), ("later frames (mean)", later, masked[len(times) - len(later):]),
+            ("all frames (mean)", times, masked))
+    for label, seconds, pixels in rows:
+        per_pixel = (seconds / pixels).mean() * 1e6
+        print(f"  {label:24s} {seconds.mean():8.2f} {per_pixel:12.1f} {PAPER_SECONDS_PER_FRAME:14.2f}")
+    print(f"  peak RSS {figures['peak']:.0f} MiB; " + ", ".join(
+        f"{label}: peak {peak:.0f} / now {now:.0f} MiB" for label, peak, now in figures["rss"]))
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--cases", nargs="*", default=list(CASES), choices=list(CASES))
+    parser.add_argument("--threads", type=int, default=2)
+    parser.add_argument("--profile", action="store_true", help="print each case's cProfile (cumulative)")
+    parser.add_argument("--child", choices=list(CASES), help=argparse.SUPPRESS)
+    args = parser.parse_args()
+    if args.child:
+        run_case(args.child, args.profile)
+        return
+    for name in args.cases:
+        report(name, run_child(name, args.threads, args.profile), args.threads)
+
+
+if __name__ == "__main__":
+    main()
