@@ -6,9 +6,10 @@ import subprocess
 import imageio_ffmpeg
 import numpy as np
 import pytest
+from PIL import Image
 
 from fluidymation.errors import StageError
-from fluidymation.stages.encode import Params, encode_mp4, pad_to_even
+from fluidymation.stages.encode import Params, encode_mp4, pad_to_even, preview_frame, write_animation
 
 
 def probe(path):
@@ -67,3 +68,23 @@ def test_no_frames_and_mismatched_frames_are_errors(tmp_path):
     with pytest.raises(StageError, match="the first was"):
         encode_mp4([np.zeros((8, 8, 3)), np.zeros((10, 8, 3))], tmp_path / "bad.mp4", params=Params(fps=24))
     assert not list(tmp_path.glob("*.mp4")) and not list(tmp_path.glob(".*part*"))
+
+
+def test_missing_ffmpeg_is_a_clear_error(tmp_path, monkeypatch):
+    def no_ffmpeg():
+        raise RuntimeError("No ffmpeg exe could be found")
+
+    monkeypatch.setattr(imageio_ffmpeg, "get_ffmpeg_exe", no_ffmpeg)
+    with pytest.raises(StageError, match="ffmpeg is not available"):
+        encode_mp4(frames(2, 8, 8), tmp_path / "x.mp4", params=Params(fps=24))
+
+
+@pytest.mark.parametrize("suffix", [".gif", ".webp"])
+def test_animated_preview_loops_at_the_frame_rate(tmp_path, suffix):
+    shown = [preview_frame(frame) for frame in frames(4, 20, 1000)]
+    assert shown[0].shape == (6, 333, 3) and shown[0].dtype == np.uint8  # 3×3 box filter: at most 480 px wide
+    write_animation(shown, tmp_path / f"p{suffix}", fps=10)
+    with Image.open(tmp_path / f"p{suffix}") as animation:
+        animation.load()
+        assert animation.n_frames == 4 and animation.size == (333, 6)
+        assert animation.info.get("loop") == 0 and animation.info.get("duration") == 100
