@@ -6,6 +6,11 @@ stage finishes, a manifest ``<output>/.cache/<stage>/<layer>.json`` records the 
 the files written; a later run whose key is unchanged and whose files are all still
 there skips the stage. Manifests are written atomically after their files, so a killed
 run never leaves a manifest for missing or partial work.
+
+A stage that can be resumed (stylize) also records when it starts: ``<layer>.partial``
+holds the key it works under and ``<layer>.state/`` what it needs to continue; a run
+under the same key continues from there, any other key empties it. Renders running at
+once take turns on each stage and layer through locks in ``.cache/locks/``.
 """
 
 from __future__ import annotations
@@ -14,8 +19,10 @@ import hashlib
 import json
 import os
 import re
+import shutil
 from pathlib import Path
 
+from fluidymation.pipeline.locks import exclusive_lock
 from fluidymation.stages.files import write_text
 
 _CHUNK = 1 << 20
@@ -50,10 +57,18 @@ class StageCache:
         self.dir = self.root / ".cache"
 
     def _manifest(self, stage: str, layer: str | None) -> Path:
-        if layer is None:
-            return self.dir / stage / "_scene.json"
-        safe = re.sub(r"[^A-Za-z0-9_.-]", "_", layer).lstrip(".")
-        return self.dir / stage / f"{safe}-{hashlib.sha256(layer.encode()).hexdigest()[:8]}.json"
+        return self.dir / stage / f"{_entry_name(layer)}.json"
+
+    def _partial(self, stage: str, layer: str | None) -> Path:
+        return self.dir / stage / f"{_entry_name(layer)}.partial"
+
+    def state_dir(self, stage: str, layer: str | None) -> Path:
+        """Where a resumable stage keeps what it needs to continue after an interruption."""
+        return self.dir / stage / f"{_entry_name(layer)}.state"
+
+    def lock(self, stage: str, layer: str | None):
+        """A context holding the lock of ``stage`` for ``layer``: one render at a time checks, runs and commits it."""
+        return exclusive_lock(self.dir / "locks" / f"{stage}-{_entry_name(layer)}.lock")
 
     def manifests(self) -> dict[tuple[str, str | None], dict]:
         """Every readable manifest, by (stage, layer); layer None for scene stages."""
@@ -79,11 +94,42 @@ class StageCache:
         return (manifest is not None and manifest.get("key") == key
                 and all((self.root / name).is_file() for name in manifest.get("files", ())))
 
-    def commit(self, stage: str, layer: str | None, key: str, files, **extra) -> None:
-        """Record that ``stage`` finished for ``layer`` under ``key``, having written ``files``."""
-        names = sorted(str(Path(f).relative_to(self.root)) for f in files)
-        write_text(self._manifest(stage, layer), json.dumps({"key": key, "layer": layer, "files": names, **extra}, indent=1) + "\n")
+    def begin(self, stage: str, layer: str | None, key: str) -> Path:
+        """Record that ``stage`` starts for ``layer`` under ``key``; return its :meth:`state_dir`.
+
+        The folder keeps what an interrupted run under the same key left; under another key it is emptied.
+        """
+        state = self.state_dir(stage, layer)
+        try:
+            started = json.loads(self._partial(stage, layer).read_text()).get("key")
+        except (OSError, ValueError):
+            started = None
+        if started != key:
+            shutil.rmtree(state, ignore_errors=True)
+            write_text(self._partial(stage, layer), json.dumps({"key": key, "layer": layer}) + "\n")
+        state.mkdir(parents=True, exist_ok=True)
+        return state
+
+    def commit(self, stage: str, layer: str | None, key: str, files, **extra) -> dict:
+        """Record that ``stage`` finished for ``layer`` under ``key``, having written ``files``; return the manifest.
+
+        What :meth:`begin` recorded is dropped.
+        """
+        manifest = {"key": key, "layer": layer, "files": sorted(str(Path(f).relative_to(self.root)) for f in files),
+                    **extra}
+        write_text(self._manifest(stage, layer), json.dumps(manifest, indent=1) + "\n")
+        self._partial(stage, layer).unlink(missing_ok=True)
+        shutil.rmtree(self.state_dir(stage, layer), ignore_errors=True)
+        return manifest
 
     def forget(self, stage: str, layer: str | None) -> None:
         """Drop the manifest (before redoing the stage), so a half-redone stage is never taken as done."""
         self._manifest(stage, layer).unlink(missing_ok=True)
+
+
+def _entry_name(layer: str | None) -> str:
+    """A file name for a layer's entries: readable and unique (``_scene`` for the scene stages)."""
+    if layer is None:
+        return "_scene"
+    safe = re.sub(r"[^A-Za-z0-9_.-]", "_", layer).lstrip(".")
+    return f"{safe}-{hashlib.sha256(layer.encode()).hexdigest()[:8]}"

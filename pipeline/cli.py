@@ -16,6 +16,7 @@ import traceback
 
 from fluidymation import __version__
 from fluidymation.errors import FluidymationError
+from fluidymation.pipeline.progress import use_json_lines
 
 COMMANDS = ("check", "masks", "guides", "synth", "exemplar", "render", "ablate", "cache")
 
@@ -43,6 +44,8 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--version", action="version", version=f"fluidymation {__version__}")
     parser.add_argument("--debug", action="store_true", help="show tracebacks and detailed logs")
     parser.add_argument("-q", "--quiet", action="store_true", help="no progress bars")
+    parser.add_argument("--json", action="store_true",
+                        help='progress as JSON lines on stderr ({"stage", "layer", "done", "total"}) instead of bars')
     subparsers = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_ArgumentParser)
     subparsers.required = True
     for name in COMMANDS:
@@ -57,6 +60,7 @@ def main(argv: list[str] | None = None) -> int:
     logging.basicConfig(level=logging.DEBUG if debug else logging.WARNING, format="%(name)s: %(message)s")
     try:
         args = build_parser().parse_args(argv)
+        use_json_lines(args.json)
         return int(args.run(args) or 0)
     except _UsageError as exc:
         print(exc, file=sys.stderr)

@@ -1,18 +1,67 @@
-"""Progress bars on stderr: shown only for work that takes over a second, never with -q."""
+"""Progress on stderr: bars shown only for work that takes over a second, or JSON lines; never with -q.
+
+With :func:`use_json_lines` (``--json``) every step of work prints one line
+``{"stage": ..., "layer": ..., "done": n, "total": m}`` instead of a bar, for programs
+that watch a render.
+"""
 
 from __future__ import annotations
 
+import json
 import sys
 
 from tqdm import tqdm
 
+_json_lines = False
 
-def progress(total: int, description: str, *, quiet: bool = False, unit: str = "frame") -> tqdm:
-    return tqdm(total=total, desc=description, unit=unit, file=sys.stderr, disable=True if quiet else None, delay=1.0,
+
+def use_json_lines(enabled: bool) -> None:
+    """Report progress as JSON lines (True) or bars (False) from now on, in this process."""
+    global _json_lines
+    _json_lines = enabled
+
+
+def json_lines() -> bool:
+    """Whether progress is reported as JSON lines."""
+    return _json_lines
+
+
+def progress(total: int | None, description: str, *, layer: str | None = None, quiet: bool = False,
+             unit: str = "frame"):
+    """A progress counter for ``total`` steps of ``description`` (a stage), optionally of a ``layer``.
+
+    Use it as a context manager; ``update(n=1)`` counts steps done.
+    """
+    if _json_lines and not quiet:
+        return JsonProgress(total, description, layer)
+    label = description if layer is None else f"{description} {layer}"
+    return tqdm(total=total, desc=label, unit=unit, file=sys.stderr, disable=True if quiet else None, delay=1.0,
                 dynamic_ncols=True, leave=False)
 
 
-def reporter(bar: tqdm):
+class JsonProgress:
+    """A progress counter that prints ``{"stage", "layer", "done", "total"}`` as a JSON line at every change."""
+
+    def __init__(self, total: int | None, stage: str, layer: str | None):
+        self.total, self.stage, self.layer, self.n = total, stage, layer, 0
+
+    def __enter__(self):
+        self.refresh()
+        return self
+
+    def __exit__(self, *exc) -> None:
+        return None
+
+    def update(self, n: int = 1) -> None:
+        self.n += n
+        self.refresh()
+
+    def refresh(self) -> None:
+        line = json.dumps({"stage": self.stage, "layer": self.layer, "done": self.n, "total": self.total})
+        print(line, file=sys.stderr, flush=True)
+
+
+def reporter(bar):
     """A ``progress(done, total)`` callback that moves ``bar``, for stages that count their own work."""
 
     def report(done: int, total: int) -> None:

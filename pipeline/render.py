@@ -6,27 +6,38 @@ the scene: ``background``, ``composite`` and ``encode``. Every stage reads its i
 from and writes its products to the output folder (DESIGN.md's output conventions) and
 records them in the stage cache (:mod:`fluidymation.pipeline.cache`), so a later run, or
 a run of a few layers only, redoes only the work whose inputs or parameters changed.
+
+Each stage checks the cache, runs and commits while holding its lock, so renders of one
+scene running at once wait for each other's work and reuse it. The stylize stage saves
+its state after every frame (:mod:`fluidymation.pipeline.resume`), so a killed render
+continues from its last finished frame. The layers are independent jobs that the
+executor (:mod:`fluidymation.pipeline.executors`) may run in other processes or on a
+Dask cluster; the scene stages run here once they are done.
 """
 
 from __future__ import annotations
 
 import dataclasses
 import json
+import logging
 import tempfile
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Callable
 
 import numpy as np
 
 from fluidymation.errors import SceneError, StageError
 from fluidymation.pipeline.cache import StageCache, file_digest, stage_key
 from fluidymation.pipeline.exemplars import exemplar_identity, layer_source, simulated_frame_count
+from fluidymation.pipeline.executors import LOCAL, run_jobs
 from fluidymation.pipeline.parameters import (
     check_layer_params, layer_guide_params, layer_stylize_params, preview_overrides,
 )
 from fluidymation.pipeline.progress import progress, reporter
 from fluidymation.pipeline.resolve import Plan, PlannedLayer
+from fluidymation.pipeline.resume import FrameStates
 from fluidymation.stages import background, colorize, composite, encode, rasterize, stylize
 from fluidymation.stages.colour import parse_hex
 from fluidymation.stages.files import read_image, write_npy, write_png, write_text
@@ -35,6 +46,8 @@ from fluidymation.stages.guide_views import write_guide_views
 LAYER_STAGES = ("masks", "guides", "stylize", "colorize")
 SCENE_STAGES = ("background", "composite", "encode")
 STAGES = LAYER_STAGES + SCENE_STAGES
+
+log = logging.getLogger(__name__)
 
 
 @dataclass(frozen=True)
@@ -49,6 +62,8 @@ class Options:
     quiet: bool = False
     force: bool = False  # redo every stage
     force_stages: tuple[str, ...] = ()  # redo these stages
+    jobs: int = 1  # layers rendered at once in local processes
+    executor: str = LOCAL  # or dask://HOST:PORT
 
 
 def scaled_plan(plan: Plan, scale: float) -> Plan:
@@ -69,9 +84,10 @@ class Report:
                        "frames": {"start": plan.start, "end": plan.end}, "preview": options.preview,
                        "until": options.until}
 
-    def stage(self, stage: str, layer: str | None, frames: int, started: float, *, cached: bool = False) -> None:
+    def stage(self, stage: str, layer: str | None, frames: int, started: float, *, cached: bool = False,
+              **details) -> None:
         self.entries.append({"stage": stage, "layer": layer, "frames": frames, "cached": cached,
-                             "seconds": round(time.perf_counter() - started, 3)})
+                             "seconds": round(time.perf_counter() - started, 3), **details})
 
     def write(self, path: Path) -> None:
         record = self.header | {"seconds": round(time.perf_counter() - self.started, 3),
@@ -96,14 +112,38 @@ def render(plan: Plan, options: Options) -> Path:
     for layer in chosen:
         check_layer_params(plan, layer)
     run = _Run(plan, options)
-    records = {layer.name: run.layer(layer) for layer in chosen}
-    write_layers_summary(plan, records, run.out / "masks", range(plan.start, plan.end))
+    # workers elsewhere print to their own stderr: keep it quiet
+    job_options = options if options.executor == LOCAL else dataclasses.replace(options, quiet=True)
+    results = run_jobs(render_layer, [(plan, job_options, layer.name) for layer in chosen],
+                       executor=options.executor, jobs=options.jobs)
+    records = {}
+    for layer, (record, entries) in zip(chosen, results):
+        records[layer.name] = record
+        run.report.entries.extend(entries)
+    with run.cache.lock("layers", None):
+        write_layers_summary(plan, records, run.out / "masks", range(plan.start, plan.end))
     if run.last >= STAGES.index("background"):
         background_key = run.background()
         if run.last >= STAGES.index("composite"):
             run.composite_and_encode(background_key)
     run.report.write(run.out / "report.json")
     return run.out
+
+
+def render_layer(plan: Plan, options: Options, name: str) -> tuple[dict, list[dict]]:
+    """The per-layer stages of layer ``name`` (a job for the executor): its summary record and report entries."""
+    run = _Run(plan, options)
+    record = run.layer(plan.layer(name))
+    return record, run.report.entries
+
+
+@dataclass
+class _Done:
+    """What a stage run wrote: its files, fields for its manifest and for its ``report.json`` entry."""
+
+    files: list[Path]
+    manifest: dict = field(default_factory=dict)
+    report: dict = field(default_factory=dict)
 
 
 class _Run:
@@ -122,6 +162,27 @@ class _Run:
         forced = self.options.force or stage in self.options.force_stages
         return not forced and self.cache.hit(stage, layer, key)
 
+    def _stage(self, stage: str, layer: str | None, key: str, frames: int, compute: Callable[[], _Done]) -> dict:
+        """Run ``compute`` for ``stage`` of ``layer`` unless the cache holds it under ``key``; return its manifest.
+
+        Holds the stage's lock from the cache check to the commit, so a concurrent render
+        of the scene waits here and then finds the work done.
+        """
+        where = stage if layer is None else f"{stage} {layer}"
+        with self.cache.lock(stage, layer):
+            started = time.perf_counter()
+            if self._fresh(stage, layer, key):
+                log.debug("%s: cached (key %s)", where, key[:12])
+                self.report.stage(stage, layer, frames, started, cached=True)
+                return self.cache.lookup(stage, layer)
+            log.debug("%s: running (key %s)", where, key[:12])
+            self.cache.forget(stage, layer)
+            done = compute()
+            manifest = self.cache.commit(stage, layer, key, done.files, **done.manifest)
+            self.report.stage(stage, layer, frames, started, **done.report)
+            log.debug("%s: finished in %.2f s, %d files", where, time.perf_counter() - started, len(done.files))
+            return manifest
+
     def _frame_span(self) -> list[int]:
         return [self.window.start - self.plan.start, self.window.stop - self.plan.start]
 
@@ -130,20 +191,17 @@ class _Run:
         plan, out = self.plan, self.out
         masks_key = stage_key("masks", rasterize.VERSION, input=input_digest(plan), select=layer.vector_layers,
                               size=plan.size, fps=plan.fps, start=plan.start, end=plan.end)
-        started = time.perf_counter()
-        if self._fresh("masks", layer.name, masks_key):
-            record = self.cache.lookup("masks", layer.name)["record"]
-            record["color"] = layer.spec.color or record["fill"]
-            self.report.stage("masks", layer.name, plan.frame_count, started, cached=True)
-        else:
-            self.cache.forget("masks", layer.name)
-            with progress(plan.frame_count, f"masks {layer.name}", quiet=self.options.quiet) as bar:
+
+        def masks() -> _Done:
+            with progress(plan.frame_count, "masks", layer=layer.name, quiet=self.options.quiet) as bar:
                 record = rasterize_layer(plan, layer, range(plan.start, plan.end), out / "masks" / layer.dirname,
                                          coverage_dir=out / "coverage" / layer.dirname, bar=bar)
             files = [out / folder / layer.dirname / f"{k:05d}.png" for folder in ("masks", "coverage")
                      for k in range(plan.frame_count)]
-            self.cache.commit("masks", layer.name, masks_key, files, record=record)
-            self.report.stage("masks", layer.name, plan.frame_count, started)
+            return _Done(files, manifest={"record": record})
+
+        record = self._stage("masks", layer.name, masks_key, plan.frame_count, masks)["record"]
+        record["color"] = layer.spec.color or record["fill"]
         if self.options.until == "guides":
             started = time.perf_counter()
             write_layer_guides(plan, layer, self.window, lambda j: read_coverage(out / "coverage" / layer.dirname, j),
@@ -167,29 +225,32 @@ class _Run:
                 sources.append(load_layer_source(plan, layer, guide_params, options.quiet))
             return sources[0]
 
-        started = time.perf_counter()
-        if self._fresh("stylize", layer.name, stylize_key):
-            self.report.stage("stylize", layer.name, len(self.window), started, cached=True)
-        else:
-            self.cache.forget("stylize", layer.name)
+        def stylized() -> _Done:
+            out_dir = out / "stylized" / layer.dirname
+            states = FrameStates(self.cache.begin("stylize", layer.name, stylize_key))
+            order = sorted((frame - plan.start for frame in self.window), reverse=params.reverse)
+            resume = states.resume_point(order, lambda index: all(
+                path.is_file() for path in stylized_files(out_dir, index, nnf=options.nnf)))
+            if resume is not None:
+                log.debug("stylize %s: resuming after frame %d (%d of %d frames were finished)",
+                          layer.name, resume[1][0], resume[0], len(order))
             files = stylize_layer(plan, layer, self.window, source(), params, guide_params,
-                                  coverage_dir=out / "coverage" / layer.dirname,
-                                  out_dir=out / "stylized" / layer.dirname, quiet=options.quiet, nnf=options.nnf)
-            self.cache.commit("stylize", layer.name, stylize_key, files)
-            self.report.stage("stylize", layer.name, len(self.window), started)
+                                  coverage_dir=out / "coverage" / layer.dirname, out_dir=out_dir, quiet=options.quiet,
+                                  nnf=options.nnf, states=states, resume=resume)
+            return _Done(files, report={"resumed": 0 if resume is None else resume[0]})
+
+        self._stage("stylize", layer.name, stylize_key, len(self.window), stylized)
         if self.last < STAGES.index("colorize"):
             return
         colorize_params = layer_colorize_params(layer, record["fill"])
         colorize_key = stage_key("colorize", colorize.VERSION, stylize=stylize_key,
                                  params=dataclasses.asdict(colorize_params), frames=self._frame_span())
-        started = time.perf_counter()
-        if self._fresh("colorize", layer.name, colorize_key):
-            self.report.stage("colorize", layer.name, len(self.window), started, cached=True)
-            return
-        self.cache.forget("colorize", layer.name)
-        files = colorize_layer(plan, layer, self.window, source(), colorize_params, out, quiet=options.quiet)
-        self.cache.commit("colorize", layer.name, colorize_key, files, frames=self._frame_span())
-        self.report.stage("colorize", layer.name, len(self.window), started)
+
+        def colorized() -> _Done:
+            files = colorize_layer(plan, layer, self.window, source(), colorize_params, out, quiet=options.quiet)
+            return _Done(files, manifest={"frames": self._frame_span()})
+
+        self._stage("colorize", layer.name, colorize_key, len(self.window), colorized)
 
     def background(self) -> str:
         """Make (or find in the cache) ``background.png``; return its key."""
@@ -200,14 +261,12 @@ class _Run:
         elif spec["type"] == "synthesized":
             parts["exemplar"] = exemplar_identity(plan, _background_layer(plan, spec.get("exemplar")))
         key = stage_key("background", background.VERSION, **parts)
-        started = time.perf_counter()
-        if self._fresh("background", None, key):
-            self.report.stage("background", None, 1, started, cached=True)
-            return key
-        self.cache.forget("background", None)
-        write_png(self.out / "background.png", make_background(plan, quiet=self.options.quiet))
-        self.cache.commit("background", None, key, [self.out / "background.png"])
-        self.report.stage("background", None, 1, started)
+
+        def paper() -> _Done:
+            write_png(self.out / "background.png", make_background(plan, quiet=self.options.quiet))
+            return _Done([self.out / "background.png"])
+
+        self._stage("background", None, key, 1, paper)
         return key
 
     def composite_and_encode(self, background_key: str) -> None:
@@ -226,11 +285,11 @@ class _Run:
         stage = "composite+encode" if encode_video else "composite"
         key = stage_key(stage, composite.VERSION * 1000 + encode.VERSION, layers=layer_keys, background=background_key,
                         frames=self._frame_span(), fps=plan.fps, output=dataclasses.asdict(output))
-        started = time.perf_counter()
-        if self._fresh(stage, None, key):
-            self.report.stage(stage, None, len(self.window), started, cached=True)
-            return
-        self.cache.forget(stage, None)
+        self._stage(stage, None, key, len(self.window), lambda: self._composite(ordered, encode_video))
+
+    def _composite(self, ordered: list[PlannedLayer], encode_video: bool) -> _Done:
+        """Composite the window's frames of ``ordered`` layers over the paper; write frames and/or the video."""
+        plan, out, output = self.plan, self.out, self.plan.scene.output
         paper = read_image(out / "background.png", channels=3)
         files, previews = [], []
 
@@ -259,8 +318,7 @@ class _Run:
         else:
             for _ in frames():
                 pass
-        self.cache.commit(stage, None, key, files)
-        self.report.stage(stage, None, len(self.window), started)
+        return _Done(files)
 
 
 def input_digest(plan: Plan) -> list[str]:
@@ -314,7 +372,7 @@ def write_layers_summary(plan: Plan, records: dict, masks_dir: Path, frames: ran
 def write_layer_guides(plan: Plan, layer: PlannedLayer, window: range, coverage, out_dir: Path, *, quiet=False,
                        raw=False, given_flow=None) -> None:
     """Guides of ``layer`` over the scene range (masks from ``coverage(index)``), views of ``window`` to ``out_dir``."""
-    with progress(1, f"guides {layer.name}", quiet=quiet, unit="step") as bar:
+    with progress(1, "guides", layer=layer.name, quiet=quiet, unit="step") as bar:
         write_guide_views(coverage, plan.frame_count, out_dir, params=layer_guide_params(plan, layer), raw=raw,
                           given_flow=given_flow, frames=(window.start - plan.start, window.stop - plan.start),
                           progress=reporter(bar))
@@ -327,32 +385,42 @@ def read_coverage(coverage_dir: Path, index: int) -> np.ndarray:
 
 def load_layer_source(plan: Plan, layer: PlannedLayer, guide_params, quiet=False) -> stylize.Source:
     """The layer's exemplar with its guides (generated on first use), with a progress bar."""
-    with progress(simulated_frame_count(plan, layer), f"exemplar for {layer.name}", quiet=quiet) as bar:
+    with progress(simulated_frame_count(plan, layer), "exemplar", layer=layer.name, quiet=quiet) as bar:
         return layer_source(plan, layer, guide_params, progress=bar.update)
 
 
+def stylized_files(out_dir: Path, index: int, *, nnf=False) -> list[Path]:
+    """The files of stylized frame ``index`` in ``out_dir``: its PNG, and its NNF with ``nnf``."""
+    return [out_dir / f"{index:05d}.png"] + ([out_dir / "nnf" / f"{index:05d}.npy"] if nnf else [])
+
+
 def stylize_layer(plan: Plan, layer: PlannedLayer, window: range, source: stylize.Source, params: stylize.Params,
-                  guide_params, *, coverage_dir: Path, out_dir: Path, quiet=False, nnf=False) -> list[Path]:
+                  guide_params, *, coverage_dir: Path, out_dir: Path, quiet=False, nnf=False,
+                  states: FrameStates | None = None, resume: tuple[int, tuple] | None = None) -> list[Path]:
     """Stylize a layer's window of scene frames (coverage read from ``coverage_dir``) into ``out_dir``.
 
-    Returns the files written. The target guides live in a temporary folder next to ``out_dir``.
+    Returns the window's files. With ``states``, each frame's state is saved after its
+    files; ``resume`` (from :meth:`FrameStates.resume_point`) continues after the frames
+    an interrupted run finished. The target guides live in a temporary folder next to ``out_dir``.
     """
     out_dir.mkdir(parents=True, exist_ok=True)
-    written = []
+    finished, after = (0, None) if resume is None else resume
     with tempfile.TemporaryDirectory(prefix=".guides-", dir=out_dir.parent) as cache_dir, \
-            progress(len(window), f"stylize {layer.name}", quiet=quiet) as bar:
+            progress(len(window), "stylize", layer=layer.name, quiet=quiet) as bar:
+        bar.update(finished)
         frames = stylize.stylize_sequence(
             lambda j: read_coverage(coverage_dir, j), plan.frame_count, source,
             params=params, guide_params=guide_params, cache_dir=cache_dir,
-            frames=(window.start - plan.start, window.stop - plan.start))
+            frames=(window.start - plan.start, window.stop - plan.start), resume=after)
         for result in frames:
-            write_png(out_dir / f"{result.index:05d}.png", result.rgba)
-            written.append(out_dir / f"{result.index:05d}.png")
-            if nnf:
-                write_npy(out_dir / "nnf" / f"{result.index:05d}.npy", result.nnf.as_array())
-                written.append(out_dir / "nnf" / f"{result.index:05d}.npy")
+            png, *nnf_file = stylized_files(out_dir, result.index, nnf=nnf)
+            write_png(png, result.rgba)
+            if nnf_file:
+                write_npy(nnf_file[0], result.nnf.as_array())
+            if states is not None:
+                states.save(result)
             bar.update()
-    return written
+    return [path for frame in window for path in stylized_files(out_dir, frame - plan.start, nnf=nnf)]
 
 
 def layer_colorize_params(layer: PlannedLayer, fill_color: str | None) -> colorize.Params:
@@ -370,7 +438,7 @@ def colorize_layer(plan: Plan, layer: PlannedLayer, window: range, source: styli
     paper = colorize.estimate_paper(source.rgb, source.segment)
     unit = colorize.full_density(source.rgb, source.segment, paper)
     written = []
-    with progress(len(window), f"colorize {layer.name}", quiet=quiet) as bar:
+    with progress(len(window), "colorize", layer=layer.name, quiet=quiet) as bar:
         for frame in window:
             name = f"{frame - plan.start:05d}.png"
             stylized = read_image(out / "stylized" / layer.dirname / name, channels=4)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from fluidymation.errors import InputError
+from fluidymation.pipeline.executors import LOCAL, dask_address
 from fluidymation.pipeline.render import STAGES, Options, render, scaled_plan
 from fluidymation.pipeline.resolve import parse_window, plan_scene
 from fluidymation.pipeline.scene import load_scene
@@ -17,7 +18,9 @@ def add_parser(subparsers) -> None:
                     "in z-order and encode the MP4 into the scene's output.dir, with report.json (timings "
                     "and cache hits per stage and layer). Work whose inputs and parameters are unchanged is "
                     "taken from the stage cache (output.dir/.cache). Stages in order: " + ", ".join(STAGES) + ". Frame files are "
-                    "numbered from the start of the scene's frame range.")
+                    "numbered from the start of the scene's frame range. A killed render started again continues "
+                    "from its last finished frame; renders of one scene running at once wait for and reuse each "
+                    "other's work.")
     parser.add_argument("scene", help="the scene's YAML file")
     parser.add_argument("--until", default=STAGES[-1], metavar="STAGE",
                         help=f"last stage to run: {', '.join(STAGES)} (default: {STAGES[-1]})")
@@ -36,6 +39,13 @@ def add_parser(subparsers) -> None:
     parser.add_argument("--nnf", action="store_true",
                         help="also save each frame's nearest-neighbour field as stylized/<layer>/nnf/00000.npy "
                              "((H, W, 4) float32: source frame, x, y, θ; frame -1 = no match)")
+    parser.add_argument("--jobs", type=int, default=1, metavar="N",
+                        help="render up to N layers at once in separate processes, sharing the CPU cores "
+                             "(default: 1)")
+    parser.add_argument("--executor", default=LOCAL, metavar="WHERE",
+                        help="where the layers are rendered: local (default) or dask://HOST:PORT, an existing Dask "
+                             "scheduler whose workers share the output folder (pip install "
+                             "'fluidymation[distributed]')")
     parser.set_defaults(run=run)
 
 
@@ -44,9 +54,13 @@ def run(args) -> int:
         raise InputError(f"--until {args.until!r}: not a stage; choose one of {', '.join(STAGES)}")
     if not 0 < args.scale <= 8:
         raise InputError(f"--scale {args.scale:g}: must be above 0 and at most 8")
+    if args.jobs < 1:
+        raise InputError(f"--jobs {args.jobs}: must be at least 1")
+    dask_address(args.executor)  # a malformed address is refused before any work
     options = Options(until=args.until, layers=tuple(args.layer) if args.layer else None,
                       window=parse_window(args.frames), preview=args.preview, nnf=args.nnf, quiet=args.quiet,
-                      force=args.force, force_stages=tuple(args.force_stage))
+                      force=args.force, force_stages=tuple(args.force_stage), jobs=args.jobs,
+                      executor=args.executor)
     plan = plan_scene(load_scene(args.scene))
     plan = scaled_plan(plan, args.scale * (PREVIEW_SCALE if args.preview else 1.0))
     out = render(plan, options)

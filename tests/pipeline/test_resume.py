@@ -1,0 +1,110 @@
+"""A render killed with SIGKILL and started again continues from its last finished frame."""
+
+import json
+import os
+import signal
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from fluidymation.engine.nnf import NNF
+from fluidymation.pipeline.cache import StageCache
+from fluidymation.pipeline.resume import FrameStates
+from fluidymation.stages.stylize import StylizedFrame
+
+ROOT = Path(__file__).parents[2]
+FRAMES = 10
+
+SCENE = f"""\
+version: 1
+input: {ROOT / "examples/blob/blob.svg"}
+fps: 12
+size: [48, 48]
+frames: {{start: 0, end: {FRAMES}}}
+output: {{dir: out, video: film.mp4}}
+background: {{type: solid, color: "#f4efe4"}}
+exemplars:
+  ink: {{builtin: watercolor-bloom, size: [32, 32], frames: 6}}
+defaults: {{exemplar: ink, params: {{opt_iters: "2, 1", pm_iters: 2}}}}
+layers:
+  - {{name: blob, color: "#2a6fdb"}}
+"""
+
+
+def fluidymation(*args, cache: Path) -> tuple[list[str], dict]:
+    """The command line and environment of a ``fluidymation`` subprocess."""
+    env = os.environ | {"FLUIDYMATION_CACHE": str(cache), "NUMBA_CACHE_DIR": str(ROOT / ".numba-cache")}
+    return [sys.executable, "-m", "fluidymation", *map(str, args)], env
+
+
+def _scene(folder: Path) -> Path:
+    folder.mkdir()
+    (folder / "scene.yaml").write_text(SCENE)
+    return folder / "scene.yaml"
+
+
+def test_a_killed_render_resumes_without_redoing_frames_and_matches_an_uninterrupted_one(tmp_path):
+    command, env = fluidymation("-q", "render", _scene(tmp_path / "whole"), cache=tmp_path / "cache")
+    assert subprocess.run(command, env=env, capture_output=True).returncode == 0
+
+    scene = _scene(tmp_path / "killed")
+    command, env = fluidymation("--json", "render", scene, cache=tmp_path / "cache")
+    render = subprocess.Popen(command, env=env, stderr=subprocess.PIPE, stdout=subprocess.DEVNULL, text=True)
+    for line in render.stderr:
+        step = json.loads(line)
+        if step["stage"] == "stylize" and step["done"] >= FRAMES // 2:
+            render.send_signal(signal.SIGKILL)
+            break
+    render.wait()
+    render.stderr.close()
+    assert render.returncode == -signal.SIGKILL
+    folder = tmp_path / "killed" / "out" / "stylized" / "blob"
+    finished = {path.name: (path.stat().st_ino, path.stat().st_mtime_ns) for path in folder.glob("*.png")}
+    assert FRAMES // 2 <= len(finished) < FRAMES
+
+    command, env = fluidymation("--debug", "-q", "render", scene, cache=tmp_path / "cache")
+    restarted = subprocess.run(command, env=env, capture_output=True, text=True)
+    assert restarted.returncode == 0, restarted.stderr
+    assert "stylize blob: resuming after frame" in restarted.stderr
+    report = json.loads((tmp_path / "killed" / "out" / "report.json").read_text())
+    resumed = next(entry["resumed"] for entry in report["stages"] if entry["stage"] == "stylize")
+    # the last frame written may lack its state if the kill came in between: then it is redone
+    assert len(finished) - 1 <= resumed <= len(finished)
+    kept = {name: stamp for name, stamp in finished.items() if int(name[:5]) < resumed}
+    assert all((folder / name).stat().st_ino == ino and (folder / name).stat().st_mtime_ns == mtime
+               for name, (ino, mtime) in kept.items())
+
+    whole = tmp_path / "whole" / "out"
+    for index in range(FRAMES):
+        name = f"stylized/blob/{index:05d}.png"
+        assert (tmp_path / "killed" / "out" / name).read_bytes() == (whole / name).read_bytes(), name
+    assert (tmp_path / "killed" / "out" / "film.mp4").read_bytes() == (whole / "film.mp4").read_bytes()
+    assert not StageCache(tmp_path / "killed" / "out").state_dir("stylize", "blob").exists()
+
+
+def _state(index, value):
+    nnf = NNF(np.full((2, 2), index, np.int32), np.full((2, 2, 3), value, np.float32))
+    return StylizedFrame(index=index, rgba=None, nnf=nnf, mean_error=0.0, backlog=np.full((2, 2), value, np.float32))
+
+
+def test_the_resume_point_is_the_longest_finished_prefix_with_a_saved_state(tmp_path):
+    states = FrameStates(tmp_path)
+    states.save(_state(5, 0.5))
+    states.save(_state(4, 0.25))  # processing in reverse: 5 then 4; 5's state is dropped
+    assert sorted(path.name for path in tmp_path.iterdir()) == ["00004.npz"]
+    order = [5, 4, 3, 2]
+    count, (index, nnf, backlog) = states.resume_point(order, lambda frame: frame in (5, 4, 2))
+    assert (count, index) == (2, 4) and nnf.frame[0, 0] == 4 and backlog[0, 0] == np.float32(0.25)
+    assert states.resume_point(order, lambda frame: frame == 5) is None  # frame 4's files are missing
+
+
+def test_a_restart_under_another_key_starts_over(tmp_path):
+    cache = StageCache(tmp_path)
+    state = cache.begin("stylize", "blob", "key-a")
+    (state / "00003.npz").write_bytes(b"state")
+    assert cache.begin("stylize", "blob", "key-a") == state and (state / "00003.npz").exists()
+    assert not any(cache.begin("stylize", "blob", "key-b").iterdir())
+    cache.commit("stylize", "blob", "key-b", [])
+    assert not state.exists() and cache.lookup("stylize", "blob")["key"] == "key-b"
