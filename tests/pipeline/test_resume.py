@@ -1,10 +1,8 @@
 """A render killed with SIGKILL and started again continues from its last finished frame."""
 
 import json
-import os
 import signal
 import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -33,24 +31,18 @@ layers:
 """
 
 
-def fluidymation(*args, cache: Path) -> tuple[list[str], dict]:
-    """The command line and environment of a ``fluidymation`` subprocess."""
-    env = os.environ | {"FLUIDYMATION_CACHE": str(cache), "NUMBA_CACHE_DIR": str(ROOT / ".numba-cache")}
-    return [sys.executable, "-m", "fluidymation", *map(str, args)], env
-
-
 def _scene(folder: Path) -> Path:
     folder.mkdir()
     (folder / "scene.yaml").write_text(SCENE)
     return folder / "scene.yaml"
 
 
-def test_a_killed_render_resumes_without_redoing_frames_and_matches_an_uninterrupted_one(tmp_path):
-    command, env = fluidymation("-q", "render", _scene(tmp_path / "whole"), cache=tmp_path / "cache")
+def test_a_killed_render_resumes_without_redoing_frames_and_matches_an_uninterrupted_one(tmp_path, command_line):
+    command, env = command_line("-q", "render", _scene(tmp_path / "whole"))
     assert subprocess.run(command, env=env, capture_output=True).returncode == 0
 
     scene = _scene(tmp_path / "killed")
-    command, env = fluidymation("--json", "render", scene, cache=tmp_path / "cache")
+    command, env = command_line("--json", "render", scene)
     render = subprocess.Popen(command, env=env, stderr=subprocess.PIPE, stdout=subprocess.DEVNULL, text=True)
     for line in render.stderr:
         step = json.loads(line)
@@ -64,7 +56,7 @@ def test_a_killed_render_resumes_without_redoing_frames_and_matches_an_uninterru
     finished = {path.name: (path.stat().st_ino, path.stat().st_mtime_ns) for path in folder.glob("*.png")}
     assert FRAMES // 2 <= len(finished) < FRAMES
 
-    command, env = fluidymation("--debug", "-q", "render", scene, cache=tmp_path / "cache")
+    command, env = command_line("--debug", "-q", "render", scene)
     restarted = subprocess.run(command, env=env, capture_output=True, text=True)
     assert restarted.returncode == 0, restarted.stderr
     assert "stylize blob: resuming after frame" in restarted.stderr

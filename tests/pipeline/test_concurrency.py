@@ -1,0 +1,51 @@
+"""Two renders of one scene at once: both succeed, the work is done once, the cache stays whole."""
+
+import subprocess
+from pathlib import Path
+
+from fluidymation.pipeline.cache import StageCache
+
+ROOT = Path(__file__).parents[2]
+
+SCENE = f"""\
+version: 1
+input: {ROOT / "examples/blob/blob.svg"}
+fps: 12
+size: [40, 40]
+frames: {{start: 0, end: 4}}
+output: {{dir: out, video: film.mp4}}
+background: {{type: solid, color: "#f4efe4"}}
+exemplars:
+  ink: {{builtin: watercolor-bloom, size: [32, 32], frames: 6}}
+defaults: {{exemplar: ink, params: {{opt_iters: "2, 1", pm_iters: 2}}}}
+layers:
+  - {{name: blob, color: "#2a6fdb"}}
+"""
+
+
+def test_two_renders_at_once_share_the_work_and_match_a_lone_render(cli, tmp_path, monkeypatch, command_line):
+    monkeypatch.setenv("FLUIDYMATION_CACHE", str(tmp_path / "cache"))
+    for folder in ("alone", "shared"):
+        (tmp_path / folder).mkdir()
+        (tmp_path / folder / "scene.yaml").write_text(SCENE)
+    assert cli("-q", "render", tmp_path / "alone" / "scene.yaml")[0] == 0
+
+    command, env = command_line("--debug", "-q", "render", tmp_path / "shared" / "scene.yaml")
+    renders = [subprocess.Popen(command, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+               for _ in range(2)]
+    logs = [render.communicate()[1] for render in renders]
+    assert [render.returncode for render in renders] == [0, 0], logs
+    # each stage ran in one render; the other waited for it and took it from the cache
+    for stage in ("masks blob", "stylize blob", "colorize blob", "composite+encode"):
+        assert sum(log.count(f"{stage}: running") for log in logs) == 1, stage
+        assert sum(log.count(f"{stage}: cached") for log in logs) == 1, stage
+
+    out = tmp_path / "shared" / "out"
+    cache = StageCache(out)
+    manifests = cache.manifests()
+    assert len(manifests) == 5 and all(cache.hit(stage, layer, manifest["key"])
+                                       for (stage, layer), manifest in manifests.items())
+    assert not list(out.rglob("*.part*"))
+    alone = tmp_path / "alone" / "out"
+    for path in sorted(alone.glob("*/blob/*.png")) + [alone / "film.mp4"]:
+        assert (out / path.relative_to(alone)).read_bytes() == path.read_bytes(), path

@@ -1,0 +1,37 @@
+"""Observability: --json progress lines on stderr, and debug logs of every stage's fate."""
+
+import json
+import logging
+from pathlib import Path
+
+BLOB = Path(__file__).parents[2] / "examples" / "blob" / "blob.svg"
+
+
+def _scene(tmp_path):
+    scene = tmp_path / "scene.yaml"
+    scene.write_text(f"input: {BLOB}\nfps: 12\nsize: [32, 32]\nframes: {{start: 0, end: 3}}\noutput: {{dir: out}}\n"
+                     "layers:\n  - {name: blob}\n  - {name: drop}\n")
+    return scene
+
+
+def test_json_replaces_the_bars_with_one_line_per_step(cli, tmp_path, monkeypatch):
+    monkeypatch.setenv("FLUIDYMATION_CACHE", str(tmp_path / "cache"))
+    code, _, err = cli("--json", "render", _scene(tmp_path), "--until", "masks")
+    assert code == 0, err
+    lines = [json.loads(line) for line in err.splitlines()]
+    assert all(set(line) == {"stage", "layer", "done", "total"} for line in lines)
+    for layer in ("blob", "drop"):
+        steps = [(line["done"], line["total"]) for line in lines if line["stage"] == "masks" and line["layer"] == layer]
+        assert steps == [(0, 3), (1, 3), (2, 3), (3, 3)]
+    code, _, err = cli("--json", "-q", "render", _scene(tmp_path), "--until", "masks", "--force")
+    assert code == 0 and err == ""
+
+
+def test_debug_logs_say_what_each_stage_did(cli, tmp_path, monkeypatch, caplog):
+    monkeypatch.setenv("FLUIDYMATION_CACHE", str(tmp_path / "cache"))
+    caplog.set_level(logging.DEBUG, logger="fluidymation")
+    assert cli("--debug", "-q", "render", _scene(tmp_path), "--until", "masks")[0] == 0
+    assert "masks blob: running (key" in caplog.text and "masks blob: finished in" in caplog.text
+    caplog.clear()
+    assert cli("--debug", "-q", "render", _scene(tmp_path), "--until", "masks")[0] == 0
+    assert "masks drop: cached (key" in caplog.text and "running" not in caplog.text
