@@ -88,7 +88,7 @@ def _is_plain_window(plain, source_height, source_width, height, width, radius, 
 def _patch_cost(
     source, target, source_rows, target_rows, feature_weights, run_weights, feature_start, plain_end, group_ends,
     weight_maps, opposite_feature, source_angle, target_angle, orientation_weight, orientation_clamp, use_opposite,
-    radius, tx, ty, frame, x, y, theta, bound,
+    radius, target_weight_rows, swapped_rows, swapped_weight_rows, tx, ty, frame, x, y, theta, bound,
 ):
     height = target.shape[0]
     width = target.shape[1]
@@ -138,27 +138,31 @@ def _patch_cost(
                 return total
         return total
     return _rotated_cost(
-        source_rows, target_rows, feature_weights, feature_start, plain_end, group_ends, weight_maps, opposite_feature,
-        opposite, source_angle, target_angle, orientation_weight, orientation_clamp, source_height, source_width, radius,
-        tx, ty, frame, x, y, theta, bound,
+        source_rows, target_rows, target_weight_rows, swapped_rows, swapped_weight_rows, feature_start, source_angle,
+        target_angle, orientation_weight, orientation_clamp, source_height, source_width, radius,
+        tx, ty, frame, x, y, theta, np.float32(math.cos(theta)), np.float32(math.sin(theta)), opposite, bound,
     )
 
 
 @kernel
 def _rotated_cost(
-    source_rows, target_rows, feature_weights, feature_start, plain_end, group_ends, weight_maps, opposite_feature,
-    opposite, source_angle, target_angle, orientation_weight, orientation_clamp, source_height, source_width, radius,
-    tx, ty, frame, x, y, theta, bound,
+    source_rows, target_rows, target_weight_rows, swapped_rows, swapped_weight_rows, feature_start, source_angle,
+    target_angle, orientation_weight, orientation_clamp, source_height, source_width, radius,
+    tx, ty, frame, x, y, theta, cos_t, sin_t, opposite, bound,
 ):
-    """The cost of a rotated or fractional candidate: bilinear samples, in float32, on the
-    row views; it stops as soon as the partial sum exceeds ``bound`` (most random
-    candidates are refused within the first few pixels)."""
-    features = feature_weights.shape[0]
+    """The cost of a candidate turned by θ (``cos_t``, ``sin_t`` given) or at a fractional
+    position: bilinear samples in float32 against the target's features and per-pixel
+    weights (their swapped copies when ``opposite``), one contiguous run of features per
+    sample so the feature loop vectorizes. It stops as soon as the partial sum exceeds
+    ``bound`` (most random candidates are refused within the first few pixels)."""
+    features = source_rows.shape[1] // source_width
     height = target_rows.shape[0]
     width = target_rows.shape[1] // features
-    groups = group_ends.shape[0]
-    cos_t = np.float32(math.cos(theta))
-    sin_t = np.float32(math.sin(theta))
+    if opposite:
+        target_rows = swapped_rows
+        target_weight_rows = swapped_weight_rows
+    length = features - feature_start
+    per_pixel = target_weight_rows.shape[0] * target_weight_rows.shape[1] > features
     high_x = np.float32(source_width - 1)
     high_y = np.float32(source_height - 1)
     one = np.float32(1.0)
@@ -184,25 +188,27 @@ def _rotated_cost(
             w11 = fx * fy
             row0 = frame_row + y0
             row1 = frame_row + min(y0 + 1, source_height - 1)
-            column0 = x0 * features
-            column1 = min(x0 + 1, source_width - 1) * features
-            target_column = qx * features
-            start = feature_start
-            for g in range(-1, groups):
-                end = plain_end if g < 0 else group_ends[g]
-                part = np.float32(0.0)
-                for c in range(start, end):
-                    sc = opposite_feature[c] if opposite else c
-                    value = (
-                        w00 * np.float32(source_rows[row0, column0 + sc])
-                        + w10 * np.float32(source_rows[row0, column1 + sc])
-                        + w01 * np.float32(source_rows[row1, column0 + sc])
-                        + w11 * np.float32(source_rows[row1, column1 + sc])
-                    )
-                    d = value - np.float32(target_rows[qy, target_column + c])
-                    part += feature_weights[c] * d * d
-                total += part if g < 0 else weight_maps[g, qy, qx] * part
-                start = max(end, feature_start)
+            column0 = x0 * features + feature_start
+            column1 = min(x0 + 1, source_width - 1) * features + feature_start
+            target_column = qx * features + feature_start
+            s00 = source_rows[row0, column0:column0 + length]
+            s10 = source_rows[row0, column1:column1 + length]
+            s01 = source_rows[row1, column0:column0 + length]
+            s11 = source_rows[row1, column1:column1 + length]
+            t = target_rows[qy, target_column:target_column + length]
+            if per_pixel:
+                w = target_weight_rows[qy, target_column:target_column + length]
+            else:
+                w = target_weight_rows[0, feature_start:features]
+            part = np.float32(0.0)
+            for k in range(length):
+                value = (
+                    w00 * np.float32(s00[k]) + w10 * np.float32(s10[k])
+                    + w01 * np.float32(s01[k]) + w11 * np.float32(s11[k])
+                )
+                d = value - np.float32(t[k])
+                part += w[k] * d * d
+            total += part
             if orientation_weight > 0.0:
                 nearest_x = int(sample_x + np.float32(0.5))
                 nearest_y = int(sample_y + np.float32(0.5))
@@ -217,7 +223,7 @@ def _rotated_cost(
 def _evaluate(
     source, target, source_rows, target_rows, feature_weights, run_weights, feature_start, plain_end, group_ends,
     weight_maps, opposite_feature, source_angle, target_angle, orientation_weight, orientation_clamp, use_opposite,
-    radius,
+    radius, target_weight_rows, swapped_rows, swapped_weight_rows,
     nnf_frame, nnf_coords, out,
 ):
     height, width = nnf_frame.shape
@@ -230,7 +236,7 @@ def _evaluate(
             out[ty, tx] = _patch_cost(
                 source, target, source_rows, target_rows, feature_weights, run_weights, feature_start, plain_end,
                 group_ends, weight_maps, opposite_feature, source_angle, target_angle, orientation_weight,
-                orientation_clamp, use_opposite, radius,
+                orientation_clamp, use_opposite, radius, target_weight_rows, swapped_rows, swapped_weight_rows,
                 tx, ty, frame, nnf_coords[ty, tx, 0], nnf_coords[ty, tx, 1], nnf_coords[ty, tx, 2], np.inf,
             )
 
@@ -266,7 +272,7 @@ def _penalty_at(penalty, use_penalty, frame, x, y):
 def _search(
     source, target, source_rows, target_rows, feature_weights, run_weights, feature_start, plain_end, group_ends,
     weight_maps, opposite_feature, source_angle, target_angle, orientation_weight, orientation_clamp, use_opposite,
-    radius,
+    radius, target_weight_rows, swapped_rows, swapped_weight_rows,
     source_segment, target_segment, penalty, use_penalty,
     nnf_frame, nnf_coords, error, start_frame, start_coords,
     rotation_mode, alpha, seed, salt, reverse, tile_rows,
@@ -346,8 +352,8 @@ def _search(
                         cand_error = _patch_cost(
                             source, target, source_rows, target_rows, feature_weights, run_weights, feature_start,
                             plain_end, group_ends, weight_maps, opposite_feature, source_angle, target_angle,
-                            orientation_weight, orientation_clamp, use_opposite, radius,
-                            tx, ty, cand_frame, cx, cy, cand_theta, bound,
+                            orientation_weight, orientation_clamp, use_opposite, radius, target_weight_rows,
+                            swapped_rows, swapped_weight_rows, tx, ty, cand_frame, cx, cy, cand_theta, bound,
                         )
                     if cand_error + cand_penalty < best_total:
                         best_frame = cand_frame
@@ -398,32 +404,55 @@ def _search(
                     cand_penalty = _penalty_at(penalty, use_penalty, cand_frame, cx, cy)
                     if cand_penalty >= best_total:
                         continue
-                    rotations = 2 if rotation_mode == ROTATION_FLOW else 1
-                    for flip in range(rotations):
-                        cand_theta = np.float32(0.0)
-                        if rotation_mode == ROTATION_FLOW:
-                            cand_theta = np.float32(
-                                _flow_rotation(target_angle, source_angle, cand_frame, cx, cy, tx, ty, flip == 1)
+                    if rotation_mode == ROTATION_FLOW:
+                        # both flow-aligned angles, θ and θ + π: one sine and cosine, and (cos of the
+                        # turn between the flows being ±1) the second one swaps the features when the first does not
+                        theta = np.float32(_flow_rotation(target_angle, source_angle, cand_frame, cx, cy, tx, ty, False))
+                        cos_t = np.float32(math.cos(theta))
+                        sin_t = np.float32(math.sin(theta))
+                        turn = 1.0
+                        if use_opposite:
+                            turn = math.cos(source_angle[cand_frame, cy_int, cx_int] + theta - target_angle[ty, tx])
+                        for flip in range(2):
+                            bound = best_total - cand_penalty
+                            cand_theta = theta if flip == 0 else np.float32(
+                                _flow_rotation(target_angle, source_angle, cand_frame, cx, cy, tx, ty, True)
                             )
-                        bound = best_total - cand_penalty
-                        if _is_plain_window(plain, source_height, source_width, height, width, radius, tx, ty, cx, cy,
-                                            cand_theta):
-                            cand_error = _window_ssd(source_rows, target_rows, run_weights, source_height, radius,
-                                                     cand_frame, cx_int, cy_int, tx, ty, bound)
-                        else:
-                            cand_error = _patch_cost(
-                                source, target, source_rows, target_rows, feature_weights, run_weights, feature_start,
-                                plain_end, group_ends, weight_maps, opposite_feature, source_angle, target_angle,
-                                orientation_weight, orientation_clamp, use_opposite, radius,
-                                tx, ty, cand_frame, cx, cy, cand_theta, bound,
+                            cand_error = _rotated_cost(
+                                source_rows, target_rows, target_weight_rows, swapped_rows, swapped_weight_rows,
+                                feature_start, source_angle, target_angle, orientation_weight,
+                                orientation_clamp, source_height, source_width, radius, tx, ty, cand_frame, cx, cy,
+                                cand_theta, cos_t if flip == 0 else -cos_t, sin_t if flip == 0 else -sin_t,
+                                turn < 0.0 if flip == 0 else turn > 0.0, bound,
                             )
-                        if cand_error + cand_penalty < best_total:
-                            best_frame = cand_frame
-                            best_x = cx
-                            best_y = cy
-                            best_theta = cand_theta
-                            best_error = cand_error
-                            best_total = cand_error + cand_penalty
+                            if cand_error + cand_penalty < best_total:
+                                best_frame = cand_frame
+                                best_x = cx
+                                best_y = cy
+                                best_theta = cand_theta
+                                best_error = cand_error
+                                best_total = cand_error + cand_penalty
+                        continue
+                    cand_theta = np.float32(0.0)
+                    bound = best_total - cand_penalty
+                    if _is_plain_window(plain, source_height, source_width, height, width, radius, tx, ty, cx, cy,
+                                        cand_theta):
+                        cand_error = _window_ssd(source_rows, target_rows, run_weights, source_height, radius,
+                                                 cand_frame, cx_int, cy_int, tx, ty, bound)
+                    else:
+                        cand_error = _patch_cost(
+                            source, target, source_rows, target_rows, feature_weights, run_weights, feature_start,
+                            plain_end, group_ends, weight_maps, opposite_feature, source_angle, target_angle,
+                            orientation_weight, orientation_clamp, use_opposite, radius, target_weight_rows,
+                            swapped_rows, swapped_weight_rows, tx, ty, cand_frame, cx, cy, cand_theta, bound,
+                        )
+                    if cand_error + cand_penalty < best_total:
+                        best_frame = cand_frame
+                        best_x = cx
+                        best_y = cy
+                        best_theta = cand_theta
+                        best_error = cand_error
+                        best_total = cand_error + cand_penalty
                 nnf_frame[ty, tx] = best_frame
                 nnf_coords[ty, tx, 0] = best_x
                 nnf_coords[ty, tx, 1] = best_y
@@ -465,6 +494,13 @@ class PatchCost:
     source_segment : ndarray, shape (T, Hs, Ws), int32
     target_segment : ndarray, shape (H, W), int32
     patch_size : int
+    target_weights : ndarray, shape (H, W, F) or (1, 1, F), float32
+        ``feature_weights`` times each feature's weight map at each target pixel (one row
+        when there are no maps), for the rotated cost.
+    swapped_features, swapped_weights : ndarray
+        ``target_features`` and ``target_weights`` with the features permuted by
+        ``opposite_feature`` (the same arrays when nothing is swapped): where the flows are
+        opposite the rotated cost compares them with the unpermuted source.
     feature_start : int
         First feature summed (``colour_channels`` for a guides-only pass).
     """
@@ -487,6 +523,9 @@ class PatchCost:
     source_segment: np.ndarray
     target_segment: np.ndarray
     patch_size: int
+    target_weights: np.ndarray
+    swapped_features: np.ndarray
+    swapped_weights: np.ndarray
     feature_start: int = 0
 
     def guides_only(self):
@@ -497,6 +536,8 @@ class PatchCost:
         """Store the current target colour (H, W, Cc) float32 into the target features."""
         colours = self.colour_channels
         _quantize(colour, self.feature_offset[:colours], self.feature_scale[:colours], self.target_features, 0)
+        if self.swapped_features is not self.target_features:  # colours are never swapped
+            _quantize(colour, self.feature_offset[:colours], self.feature_scale[:colours], self.swapped_features, 0)
 
     def kernel_args(self):
         frames, source_height, source_width, features = self.source_features.shape
@@ -508,8 +549,13 @@ class PatchCost:
             np.tile(self.feature_weights, self.patch_size), self.feature_start, self.plain_end, self.group_ends,
             self.weight_maps, self.opposite_feature, self.source_angle, self.target_angle,
             np.float32(self.orientation_weight), np.float32(self.orientation_clamp), self.use_opposite,
-            self.patch_size // 2,
+            self.patch_size // 2, _rows(self.target_weights), _rows(self.swapped_features), _rows(self.swapped_weights),
         )
+
+
+def _rows(array):
+    """(H, W, F) as (H, W·F)."""
+    return array.reshape(array.shape[0], -1)
 
 
 @dataclass(frozen=True)
@@ -585,6 +631,8 @@ def quantize_source(source_colour, source_guides, *, guide_weight_map=None, oppo
     if use_opposite:
         opposite_guide = np.asarray(opposite_guide, np.int64).reshape(guides)
         opposite_feature[colours + position] = colours + position[opposite_guide]
+        if (opposite_feature[opposite_feature] != np.arange(colours + guides)).any():
+            raise ValueError(f"opposite_guide must swap guides (applied twice give each back), got {opposite_guide}")
     low_bound = np.concatenate([_channel_min(source_colour), _channel_min(source_guides)])
     high_bound = np.concatenate([_channel_max(source_colour), _channel_max(source_guides)])
     feature_order = np.concatenate([np.arange(colours), colours + order])
@@ -712,12 +760,28 @@ def target_patch_cost(features, *, target_colour, target_guides, colour_weights,
         target_segment = np.zeros((height, width), np.int32)
     if weight_maps is None:
         weight_maps = np.zeros((0, height, width), np.float32)
+    feature_weights = (weights / scale.astype(np.float64) ** 2).astype(np.float32)
+    group = np.concatenate([np.full(plain_end, -1), np.repeat(np.arange(maps), np.diff(group_ends, prepend=plain_end))])
+    if maps:
+        target_weights = np.empty((height, width, colours + guides), np.float32)
+        for feature in range(colours + guides):
+            if group[feature] < 0:
+                target_weights[:, :, feature] = feature_weights[feature]
+            else:
+                np.multiply(weight_maps[group[feature]], feature_weights[feature], out=target_weights[:, :, feature])
+    else:
+        target_weights = feature_weights.reshape(1, 1, -1).copy()
+    swap = features.opposite_feature
+    swapped_codes = target_codes[..., swap] if features.use_opposite else target_codes
+    swapped_weights = target_weights
+    if features.use_opposite and (group[swap] != group).any():
+        swapped_weights = np.ascontiguousarray(target_weights[..., swap])
     return PatchCost(
         source_features=features.codes,
         target_features=target_codes,
         feature_offset=offset,
         feature_scale=scale,
-        feature_weights=(weights / scale.astype(np.float64) ** 2).astype(np.float32),
+        feature_weights=feature_weights,
         colour_channels=colours,
         plain_end=plain_end,
         group_ends=group_ends,
@@ -731,6 +795,9 @@ def target_patch_cost(features, *, target_colour, target_guides, colour_weights,
         source_segment=np.ascontiguousarray(source_segment, np.int32),
         target_segment=np.ascontiguousarray(target_segment, np.int32),
         patch_size=int(patch_size),
+        target_weights=target_weights,
+        swapped_features=swapped_codes,
+        swapped_weights=swapped_weights,
     )
 
 

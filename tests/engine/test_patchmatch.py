@@ -156,3 +156,8 @@ def test_window_ssd_matches_naive_cost_inside_both_images():
         assert got == pytest.approx(expected, rel=1e-4)
         stopped = _window_ssd(source_rows, target_rows, run_weights, 9, 2, frame, sx, sy, tx, ty, np.float32(0.0))
         assert stopped < expected  # early termination after the first row
+
+
+def test_opposite_guide_must_be_a_swap():
+    with pytest.raises(ValueError, match="swap"):
+        make_cost(np.random.default_rng(8), guide_weights=(2.0, 2.0), opposite_guide=[1, 1])
