@@ -18,7 +18,7 @@ def add_parser(subparsers) -> None:
         "cache", help="show or prune a scene's stage cache",
         description="info: the finished stage work recorded for the scene (stage, layer, files, size), and the "
                     "size of the user cache of exemplars. prune: delete files in the scene's output folder that "
-                    "no finished stage refers to (frames of older runs, leftovers of interrupted ones); with "
+                    "no finished stage refers to (frames of older runs, leftovers of interrupted ones such as their temporary guide folders); with "
                     "--exemplars also empty the user cache of generated exemplars and their guides.")
     parser.add_argument("action", choices=("info", "prune"))
     parser.add_argument("scene", help="the scene's YAML file")
@@ -51,7 +51,7 @@ def run(args) -> int:
             if path.is_file() and path not in kept and path.name != "layers.json":
                 path.unlink()
                 removed += 1
-    for leftover in out.glob(".guides-*"):
+    for leftover in [*out.glob(".guides-*"), *out.glob("*/.guides-*")]:
         shutil.rmtree(leftover, ignore_errors=True)
         removed += 1
     if args.exemplars:
