@@ -11,7 +11,17 @@ from fluidymation.engine.sampling import _bilinear_setup
 
 
 @parallel_kernel
-def _vote(source, nnf_frame, nnf_coords, radius, out, coverage):
+def _turns(nnf_coords, out):
+    """cos θ and sin θ of every match (a pixel is voted by n² patches: one sine each, not n²)."""
+    for ty in prange(nnf_coords.shape[0]):
+        for tx in range(nnf_coords.shape[1]):
+            theta = nnf_coords[ty, tx, 2]
+            out[ty, tx, 0] = math.cos(theta)
+            out[ty, tx, 1] = math.sin(theta)
+
+
+@parallel_kernel
+def _vote(source, nnf_frame, nnf_coords, turns, radius, out, coverage):
     height, width = nnf_frame.shape
     source_height = source.shape[1]
     source_width = source.shape[2]
@@ -41,8 +51,8 @@ def _vote(source, nnf_frame, nnf_coords, radius, out, coverage):
                         for c in range(channels):
                             total[c] += source[frame, sy, sx, c]
                     else:
-                        cos_t = math.cos(theta)
-                        sin_t = math.sin(theta)
+                        cos_t = turns[ny, nx, 0]
+                        sin_t = turns[ny, nx, 1]
                         x0, y0, x1, y1, w00, w10, w01, w11 = _bilinear_setup(
                             x + cos_t * dx - sin_t * dy, y + sin_t * dx + cos_t * dy, source_height, source_width
                         )
@@ -84,5 +94,7 @@ def vote(source, nnf, *, patch_size):
     height, width = nnf.shape
     out = np.empty((height, width, source.shape[3]), np.float32)
     coverage = np.empty((height, width), np.int32)
-    _vote(source, nnf.frame, nnf.coords, patch_size // 2, out, coverage)
+    turns = np.empty((height, width, 2), np.float32)
+    _turns(nnf.coords, turns)
+    _vote(source, nnf.frame, nnf.coords, turns, patch_size // 2, out, coverage)
     return out, coverage

@@ -164,12 +164,14 @@ def report(name, figures, threads):
           f"{figures['loads'][0]:.2f} -> {figures['loads'][1]:.2f}")
     print(f"  warm-up (numba load/compile, tiny scene) {figures['warm_up']:.1f} s; "
           f"target guides {figures['guides']:.1f} s ({figures['guides'] / frame_count:.2f} s/frame)")
-    print(f"  {'':24s} {'s/frame':>8s} {'µs/px/frame':>12s} {'paper s/frame':>14s}")
+    paper = name == "speed"
+    print(f"  {'':24s} {'s/frame':>8s} {'µs/px/frame':>12s}" + (f" {'paper s/frame':>14s}" if paper else ""))
     rows = (("first frame", times[:1], masked[:1]), ("later frames (mean)", later, masked[len(times) - len(later):]),
             ("all frames (mean)", times, masked))
     for label, seconds, pixels in rows:
         per_pixel = (seconds / pixels).mean() * 1e6
-        print(f"  {label:24s} {seconds.mean():8.2f} {per_pixel:12.1f} {PAPER_SECONDS_PER_FRAME:14.2f}")
+        print(f"  {label:24s} {seconds.mean():8.2f} {per_pixel:12.1f}"
+              + (f" {PAPER_SECONDS_PER_FRAME:14.2f}" if paper else ""))
     print(f"  peak RSS {figures['peak']:.0f} MiB; " + ", ".join(
         f"{label}: peak {peak:.0f} / now {now:.0f} MiB" for label, peak, now in figures["rss"]))
 
