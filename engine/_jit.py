@@ -1,6 +1,7 @@
 """The one place that sets numba's compilation flags for every kernel.
 
-``kernel`` compiles serial code; ``parallel_kernel`` adds ``prange`` support. Both are
+``kernel`` compiles serial code; ``parallel_kernel`` adds ``prange`` support;
+``inline_kernel`` is a ``kernel`` inlined into its callers. All are
 cached on disk (``NUMBA_CACHE_DIR`` selects where) and use fastmath. Kernels that run
 in parallel must write disjoint slices so results do not depend on the thread count.
 ``prefetch`` asks the CPU to start loading an array element's cache line.
@@ -17,6 +18,9 @@ from numba.extending import intrinsic
 
 kernel = numba.njit(cache=True, fastmath=True, nogil=True)
 parallel_kernel = numba.njit(cache=True, fastmath=True, nogil=True, parallel=True)
+#: A ``kernel`` copied into each caller (no call with dozens of array fields per use;
+#: longer compilation): for small functions called in the innermost loops.
+inline_kernel = numba.njit(cache=True, fastmath=True, nogil=True, inline="always")
 
 
 @intrinsic

@@ -36,7 +36,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 from numba import prange
 
-from fluidymation.engine._jit import kernel, parallel_kernel, prefetch
+from fluidymation.engine._jit import inline_kernel, kernel, parallel_kernel, prefetch
 from fluidymation.engine.nnf import ROTATION_FLOW, _flow_rotation
 from fluidymation.engine.random import _key4, _random_below
 from fluidymation.engine.sampling import _bilinear_setup
@@ -144,7 +144,7 @@ def _patch_cost(
     )
 
 
-@kernel
+@inline_kernel
 def _rotated_cost(
     source_rows, target_rows, target_weight_rows, swapped_rows, swapped_weight_rows, feature_start, source_angle,
     target_angle, orientation_weight, orientation_clamp, source_height, source_width, radius,

@@ -11,24 +11,26 @@ from fluidymation.engine.sampling import _bilinear_setup
 
 
 @parallel_kernel
-def _turns(nnf_coords, out):
-    """cos θ and sin θ of every match (a pixel is voted by n² patches: one sine each, not n²)."""
-    for ty in prange(nnf_coords.shape[0]):
-        for tx in range(nnf_coords.shape[1]):
+def _turns(nnf_coords, box, out):
+    """cos θ and sin θ of every match in the box (a pixel is voted by n² patches: one sine each, not n²)."""
+    y_begin, y_end, x_begin, x_end = box
+    for ty in prange(y_begin, y_end):
+        for tx in range(x_begin, x_end):
             theta = nnf_coords[ty, tx, 2]
             out[ty, tx, 0] = math.cos(theta)
             out[ty, tx, 1] = math.sin(theta)
 
 
 @parallel_kernel
-def _vote(source, nnf_frame, nnf_coords, turns, radius, out, coverage):
+def _vote(source, nnf_frame, nnf_coords, turns, radius, box, out, coverage):
     height, width = nnf_frame.shape
     source_height = source.shape[1]
     source_width = source.shape[2]
     channels = source.shape[3]
-    for ty in prange(height):
+    y_begin, y_end, x_begin, x_end = box
+    for ty in prange(y_begin, y_end):
         total = np.zeros(channels, np.float32)
-        for tx in range(width):
+        for tx in range(x_begin, x_end):
             total[:] = 0.0
             count = 0
             for dy in range(-radius, radius + 1):
@@ -92,9 +94,18 @@ def vote(source, nnf, *, patch_size):
     if source.ndim != 4:
         raise ValueError(f"source must have shape (T, H, W, C), got {source.shape}")
     height, width = nnf.shape
-    out = np.empty((height, width, source.shape[3]), np.float32)
-    coverage = np.empty((height, width), np.int32)
+    out = np.zeros((height, width, source.shape[3]), np.float32)
+    coverage = np.zeros((height, width), np.int32)
+    matched = nnf.frame >= 0
+    rows = np.flatnonzero(matched.any(axis=1))
+    if rows.size == 0:
+        return out, coverage
+    columns = np.flatnonzero(matched.any(axis=0))
+    radius = patch_size // 2
+    # only pixels a patch can reach: the matches' bounding box grown by the patch radius
+    box = (max(rows[0] - radius, 0), min(rows[-1] + radius + 1, height),
+           max(columns[0] - radius, 0), min(columns[-1] + radius + 1, width))
     turns = np.empty((height, width, 2), np.float32)
-    _turns(nnf.coords, turns)
-    _vote(source, nnf.frame, nnf.coords, turns, patch_size // 2, out, coverage)
+    _turns(nnf.coords, np.array(box, np.int64), turns)
+    _vote(source, nnf.frame, nnf.coords, turns, radius, np.array(box, np.int64), out, coverage)
     return out, coverage
