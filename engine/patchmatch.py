@@ -407,7 +407,9 @@ def _search(
                     if rotation_mode == ROTATION_FLOW:
                         # both flow-aligned angles, θ and θ + π: one sine and cosine, and (cos of the
                         # turn between the flows being ±1) the second one swaps the features when the first does not
-                        theta = np.float32(_flow_rotation(target_angle, source_angle, cand_frame, cx, cy, tx, ty, False))
+                        theta = np.float32(
+                            _flow_rotation(target_angle, source_angle, cand_frame, cx, cy, tx, ty, False)
+                        )
                         cos_t = np.float32(math.cos(theta))
                         sin_t = np.float32(math.sin(theta))
                         turn = 1.0

@@ -5,6 +5,11 @@ coarser level, optionally merged per pixel with a supplied NNF downscaled to the
 vote, then repeat ``search_vote_iters`` times: PatchMatch (``patchmatch_iters`` passes,
 the uniformity map recomputed before each pass) and vote. Per-level schedules are given
 coarsest first; the last value repeats for the finer levels.
+
+:func:`synthesize` builds the source's pyramid and 16-bit features for its one target.
+A sequence of targets from one source (the stylize stage's frames) builds them once with
+:func:`prepare_source` and calls :func:`synthesize_prepared` per target; levels with
+few pixels run their kernels on one thread (:func:`fluidymation.engine._jit.threads_for`).
 """
 
 from __future__ import annotations
@@ -20,7 +25,9 @@ from fluidymation.engine.nnf import (
 from fluidymation.engine.patchmatch import (
     TILE_ROWS, SourceFeatures, patch_errors, patchmatch_pass, quantize_source, target_patch_cost,
 )
-from fluidymation.engine.pyramid import downsample, downsample_angles, downsample_labels, gaussian_pyramid, levels_that_fit
+from fluidymation.engine.pyramid import (
+    downsample, downsample_angles, downsample_labels, gaussian_pyramid, levels_that_fit,
+)
 from fluidymation.engine.uniformity import budget_scales, occurrence_map, uniformity_penalty
 from fluidymation.engine.vote import vote
 
@@ -240,7 +247,8 @@ def _check_target(target, colours, guides):
     shapes = {"weight_maps": (None, height, width), "target_angle": (height, width), "target_segment": (height, width)}
     for name, shape in shapes.items():
         value = getattr(target, name)
-        if value is not None and (value.ndim != len(shape) or any(s is not None and s != v for s, v in zip(shape, value.shape))):
+        if value is not None and (value.ndim != len(shape)
+                                  or any(s is not None and s != v for s, v in zip(shape, value.shape))):
             raise ValueError(f"{name} must have shape {shape}, got {value.shape}")
     if target.initial_nnf is not None and target.initial_nnf.shape != (height, width):
         raise ValueError(f"initial_nnf must have shape {(height, width)}, got {target.initial_nnf.shape}")
@@ -384,97 +392,104 @@ def synthesize_prepared(source, target, params=SynthesisParams()):
 def _synthesize(source, target, params, target_guides):
     """The multi-scale loop over the levels of ``target_guides`` (a pyramid, finest first)."""
     levels = len(target_guides)
-    colours = source.shape[3]
     height, width = target_guides[0].shape[:2]
-    rotation_mode = _ROTATIONS[params.rotation]
-    if rotation_mode == ROTATION_FLOW and (source.levels[0].angle is None or target.target_angle is None):
+    if _ROTATIONS[params.rotation] == ROTATION_FLOW and (source.levels[0].angle is None or target.target_angle is None):
         raise ValueError('rotation="flow" needs source_angle and target_angle')
-
     target_segment = target.target_segment
     if target_segment is None:
         target_segment = np.zeros((height, width), np.int32)
     weight_maps = _pyramid_or_none(target.weight_maps, levels, _downsample_maps)
     target_angle = _pyramid_or_none(target.target_angle, levels, downsample_angles)
     target_segments = _pyramid_or_none(np.asarray(target_segment, np.int32), levels, downsample_labels)
-
     nnf = None
     for rank, level in enumerate(range(levels - 1, -1, -1)):
-        prepared = source.levels[level]
         level_height, level_width = target_guides[level].shape[:2]
         with threads_for(level_height * level_width):
-            level_source_shape = prepared.colour.shape[1:3]
-            cost = target_patch_cost(
-                prepared.features, target_colour=np.zeros((level_height, level_width, colours), np.float32),
-                target_guides=target_guides[level], colour_weights=target.colour_weights,
-                guide_weights=target.guide_weights, weight_maps=weight_maps[level], source_angle=prepared.angle,
-                target_angle=target_angle[level], orientation_weight=params.orientation_weight,
-                orientation_clamp=params.orientation_clamp, source_segment=prepared.segment,
-                target_segment=target_segments[level], patch_size=params.patch_size,
+            nnf, colour, cost = _synthesize_level(
+                source.levels[level], target, params, rank=rank, level=level, nnf=nnf,
+                optimise=not (level == 0 and levels > 1 and params.vote_only_finest), target_guides=target_guides[level],
+                weight_maps=weight_maps[level], target_angle=target_angle[level], target_segment=target_segments[level],
             )
-
-            def repair(field, salt):
-                fill_random(
-                    field, target_segment=cost.target_segment, source_segment=cost.source_segment, seed=params.seed, salt=salt, replace_all=False,
-                    rotation_mode=rotation_mode, target_angle=target_angle[level], source_angle=prepared.angle,
-                    index=prepared.index,
-                )
-
-            def revote():
-                colour, _ = vote(prepared.colour, nnf, patch_size=params.patch_size)
-                cost.set_target_colour(colour)
-                return colour
-
-            def downscaled_initial():
-                field = downscale_nnf(target.initial_nnf, steps=level, target_shape=(level_height, level_width),
-                                      source_shape=level_source_shape)
-                repair(field, _salt(level, 1, 0, 0))
-                return field
-
-            random_start = nnf is None and target.initial_nnf is None
-            if nnf is None:
-                nnf = downscaled_initial() if target.initial_nnf is not None else NNF.empty(level_height, level_width)
-                repair(nnf, _salt(level, 0, 0, 0))
-            else:
-                nnf = upscale_nnf(nnf, target_shape=(level_height, level_width), source_shape=level_source_shape)
-                repair(nnf, _salt(level, 0, 0, 0))
-                if target.initial_nnf is not None:
-                    revote()
-                    other = downscaled_initial()
-                    nnf, _ = merge_nnf(nnf, other, patch_errors(cost, nnf), patch_errors(cost, other))
-            colour = revote()
-
-            if random_start and params.guided_initialization:
-                guides_cost = cost.guides_only()
-                error = patch_errors(guides_cost, nnf)
-                for iteration in range(_schedule(params.patchmatch_iters, rank)):
-                    patchmatch_pass(guides_cost, nnf, error, rotation_mode=rotation_mode, alpha=params.alpha,
-                                    seed=params.seed, salt=_salt(level, 2, 0, iteration), reverse=iteration % 2 == 1,
-                                    tile_rows=params.tile_rows)
-                colour = revote()
-
-            if level == 0 and levels > 1 and params.vote_only_finest:
-                break
-            scales = None
-            if params.uniformity_weight > 0:
-                scales = budget_scales(source_segment=cost.source_segment, target_segment=cost.target_segment,
-                                       patch_size=params.patch_size, frame_radius=params.uniformity_radius,
-                                       weight=params.uniformity_weight)
-            for em in range(_schedule(params.search_vote_iters, rank)):
-                error = patch_errors(cost, nnf)
-                for iteration in range(_schedule(params.patchmatch_iters, rank)):
-                    penalty = None
-                    if scales is not None:
-                        occurrence = occurrence_map(nnf, source_shape=cost.source_segment.shape,
-                                                    patch_size=params.patch_size, frame_radius=params.uniformity_radius)
-                        penalty = uniformity_penalty(occurrence, source_segment=cost.source_segment, scales=scales,
-                                                     patch_size=params.patch_size)
-                    patchmatch_pass(cost, nnf, error, penalty=penalty, rotation_mode=rotation_mode, alpha=params.alpha,
-                                    seed=params.seed, salt=_salt(level, 3, em, iteration), reverse=iteration % 2 == 1,
-                                    tile_rows=params.tile_rows)
-                colour = revote()
     with threads_for(height * width):
         error = patch_errors(cost, nnf)
     return SynthesisResult(image=colour, nnf=nnf, error=error)
+
+
+def _synthesize_level(prepared, target, params, *, rank, level, nnf, optimise, target_guides, weight_maps, target_angle,
+                      target_segment):
+    """One pyramid level: start from ``nnf`` (the coarser level's, or None), return (nnf, colour, cost)."""
+    rotation_mode = _ROTATIONS[params.rotation]
+    level_height, level_width = target_guides.shape[:2]
+    level_source_shape = prepared.colour.shape[1:3]
+    cost = target_patch_cost(
+        prepared.features, target_colour=np.zeros((level_height, level_width, prepared.colour.shape[3]), np.float32),
+        target_guides=target_guides, colour_weights=target.colour_weights, guide_weights=target.guide_weights,
+        weight_maps=weight_maps, source_angle=prepared.angle, target_angle=target_angle,
+        orientation_weight=params.orientation_weight, orientation_clamp=params.orientation_clamp,
+        source_segment=prepared.segment, target_segment=target_segment, patch_size=params.patch_size,
+    )
+
+    def repair(field, salt):
+        fill_random(
+            field, target_segment=cost.target_segment, source_segment=cost.source_segment, seed=params.seed, salt=salt,
+            replace_all=False, rotation_mode=rotation_mode, target_angle=target_angle, source_angle=prepared.angle,
+            index=prepared.index,
+        )
+
+    def revote():
+        colour, _ = vote(prepared.colour, nnf, patch_size=params.patch_size)
+        cost.set_target_colour(colour)
+        return colour
+
+    def downscaled_initial():
+        field = downscale_nnf(target.initial_nnf, steps=level, target_shape=(level_height, level_width),
+                              source_shape=level_source_shape)
+        repair(field, _salt(level, 1, 0, 0))
+        return field
+
+    random_start = nnf is None and target.initial_nnf is None
+    if nnf is None:
+        nnf = downscaled_initial() if target.initial_nnf is not None else NNF.empty(level_height, level_width)
+        repair(nnf, _salt(level, 0, 0, 0))
+    else:
+        nnf = upscale_nnf(nnf, target_shape=(level_height, level_width), source_shape=level_source_shape)
+        repair(nnf, _salt(level, 0, 0, 0))
+        if target.initial_nnf is not None:
+            revote()
+            other = downscaled_initial()
+            nnf, _ = merge_nnf(nnf, other, patch_errors(cost, nnf), patch_errors(cost, other))
+    colour = revote()
+
+    if random_start and params.guided_initialization:
+        guides_cost = cost.guides_only()
+        error = patch_errors(guides_cost, nnf)
+        for iteration in range(_schedule(params.patchmatch_iters, rank)):
+            patchmatch_pass(guides_cost, nnf, error, rotation_mode=rotation_mode, alpha=params.alpha,
+                            seed=params.seed, salt=_salt(level, 2, 0, iteration), reverse=iteration % 2 == 1,
+                            tile_rows=params.tile_rows)
+        colour = revote()
+
+    if not optimise:
+        return nnf, colour, cost
+    scales = None
+    if params.uniformity_weight > 0:
+        scales = budget_scales(source_segment=cost.source_segment, target_segment=cost.target_segment,
+                               patch_size=params.patch_size, frame_radius=params.uniformity_radius,
+                               weight=params.uniformity_weight)
+    for em in range(_schedule(params.search_vote_iters, rank)):
+        error = patch_errors(cost, nnf)
+        for iteration in range(_schedule(params.patchmatch_iters, rank)):
+            penalty = None
+            if scales is not None:
+                occurrence = occurrence_map(nnf, source_shape=cost.source_segment.shape,
+                                            patch_size=params.patch_size, frame_radius=params.uniformity_radius)
+                penalty = uniformity_penalty(occurrence, source_segment=cost.source_segment, scales=scales,
+                                             patch_size=params.patch_size)
+            patchmatch_pass(cost, nnf, error, penalty=penalty, rotation_mode=rotation_mode, alpha=params.alpha,
+                            seed=params.seed, salt=_salt(level, 3, em, iteration), reverse=iteration % 2 == 1,
+                            tile_rows=params.tile_rows)
+        colour = revote()
+    return nnf, colour, cost
 
 
 def _salt(level, phase, em, iteration):
