@@ -76,3 +76,19 @@ def test_one_layer_rerendered_and_forced_stages(cli, tmp_path, monkeypatch):
     assert {entry["layer"] for entry in report["stages"]} == {"drop", None}
     code, out, _ = cli("cache", "info", scene)
     assert code == 0 and "stylize" in out and "complete" in out
+
+
+def test_prune_keeps_finished_work_and_removes_the_rest(cli, tmp_path, monkeypatch):
+    monkeypatch.setenv("FLUIDYMATION_CACHE", str(tmp_path / "cache"))
+    scene = _write(tmp_path)
+    assert cli("-q", "render", scene, "--until", "stylize")[0] == 0
+    stale = tmp_path / "out" / "stylized" / "blob" / "00099.png"
+    stale.write_bytes(b"left over from an older run")
+    leftover = tmp_path / "out" / "stylized" / ".guides-killed"
+    leftover.mkdir()
+    kept = sorted((tmp_path / "out" / "stylized" / "blob").glob("0000*.png"))
+    code, out, _ = cli("cache", "prune", scene)
+    assert code == 0 and "removed 2" in out
+    assert not stale.exists() and not leftover.exists() and all(path.is_file() for path in kept)
+    assert cli("-q", "render", scene, "--until", "stylize")[0] == 0
+    assert _ran(tmp_path)[0] == set()
