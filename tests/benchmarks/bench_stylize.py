@@ -162,7 +162,7 @@ def report(name, figures, threads):
     masked = np.array(figures["masked"], np.float64)
     later = times[1:] if len(times) > 1 else times
     print(f"\n{name}: target {width}x{height} px, {frame_count} frames, {masked.mean():.0f} masked px/frame; "
-          f"exemplar {ex_width}x{ex_height}x{ex_frames}; {threads} threads; load average "
+          f"exemplar {ex_width}x{ex_height}x{ex_frames}; {threads} thread{'s' * (threads > 1)}; load average "
           f"{figures['loads'][0]:.2f} -> {figures['loads'][1]:.2f}")
     print(f"  warm-up (numba load/compile, tiny scene) {figures['warm_up']:.1f} s; target guides of all "
           f"{frame_count} frames {figures['guides']:.1f} s (the stage's first frame includes them)")
