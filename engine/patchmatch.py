@@ -536,10 +536,10 @@ class PatchCost:
 
     def set_target_colour(self, colour):
         """Store the current target colour (H, W, Cc) float32 into the target features."""
-        colours = self.colour_channels
-        _quantize(colour, self.feature_offset[:colours], self.feature_scale[:colours], self.target_features, 0)
+        columns = np.arange(self.colour_channels)
+        _quantize(colour, self.feature_offset, self.feature_scale, self.target_features, columns)
         if self.swapped_features is not self.target_features:  # colours are never swapped
-            _quantize(colour, self.feature_offset[:colours], self.feature_scale[:colours], self.swapped_features, 0)
+            _quantize(colour, self.feature_offset, self.feature_scale, self.swapped_features, columns)
 
     def kernel_args(self):
         frames, source_height, source_width, features = self.source_features.shape
@@ -577,6 +577,8 @@ class SourceFeatures:
     colour_channels : int
     guide_order : ndarray of int, shape (G,)
         The caller's guide channel stored at each guide feature.
+    guide_columns : ndarray of int, shape (G,)
+        The feature storing each of the caller's guide channels.
     guide_weight_map : ndarray of int, shape (G,)
         Weight map of each guide (caller's order), -1 for none.
     opposite_feature : ndarray, shape (F,), int64
@@ -588,13 +590,10 @@ class SourceFeatures:
     scale: np.ndarray
     colour_channels: int
     guide_order: np.ndarray
+    guide_columns: np.ndarray
     guide_weight_map: np.ndarray
     opposite_feature: np.ndarray
     use_opposite: bool
-
-    def in_feature_order(self, guides):
-        """Guide channels (..., G) in the caller's order, reordered as the features store them."""
-        return np.asarray(guides, np.float32)[..., self.guide_order]
 
 
 def quantize_source(source_colour, source_guides, *, guide_weight_map=None, opposite_guide=None, low=None, high=None):
@@ -627,7 +626,6 @@ def quantize_source(source_colour, source_guides, *, guide_weight_map=None, oppo
     order = np.argsort(np.where(guide_weight_map < 0, -1, guide_weight_map), kind="stable")
     position = np.empty(guides, np.int64)
     position[order] = np.arange(guides)
-    source_guides = source_guides[..., order]
     opposite_feature = np.arange(colours + guides, dtype=np.int64)
     use_opposite = opposite_guide is not None
     if use_opposite:
@@ -635,8 +633,8 @@ def quantize_source(source_colour, source_guides, *, guide_weight_map=None, oppo
         opposite_feature[colours + position] = colours + position[opposite_guide]
         if (opposite_feature[opposite_feature] != np.arange(colours + guides)).any():
             raise ValueError(f"opposite_guide must swap guides (applied twice give each back), got {opposite_guide}")
-    low_bound = np.concatenate([_channel_min(source_colour), _channel_min(source_guides)])
-    high_bound = np.concatenate([_channel_max(source_colour), _channel_max(source_guides)])
+    low_bound = np.concatenate([_channel_min(source_colour), _channel_min(source_guides)[order]])
+    high_bound = np.concatenate([_channel_max(source_colour), _channel_max(source_guides)[order]])
     feature_order = np.concatenate([np.arange(colours), colours + order])
     if low is not None:
         low_bound = np.minimum(low_bound, np.asarray(low, np.float64).reshape(colours + guides)[feature_order])
@@ -649,11 +647,11 @@ def quantize_source(source_colour, source_guides, *, guide_weight_map=None, oppo
     scale = np.where(span > 0, _CODE_MAX / np.where(span > 0, span, 1.0), 1.0).astype(np.float32)
     offset = low_bound.astype(np.float32)
     codes = np.empty((frames, source_height, source_width, colours + guides), _CODE)
-    _quantize(source_colour, offset[:colours], scale[:colours], codes, 0)
-    _quantize(source_guides, offset[colours:], scale[colours:], codes, colours)
+    _quantize(source_colour, offset, scale, codes, np.arange(colours))
+    _quantize(source_guides, offset, scale, codes, colours + position)  # no reordered copy of the guides
     return SourceFeatures(
         codes=codes, offset=offset, scale=scale, colour_channels=colours, guide_order=order,
-        guide_weight_map=guide_weight_map, opposite_feature=opposite_feature, use_opposite=use_opposite,
+        guide_columns=colours + position, guide_weight_map=guide_weight_map, opposite_feature=opposite_feature, use_opposite=use_opposite,
     )
 
 
@@ -748,8 +746,8 @@ def target_patch_cost(features, *, target_colour, target_guides, colour_weights,
         raise ValueError("guides swapped by opposite_guide must have equal weights")
     offset, scale = features.offset, features.scale
     target_codes = np.empty((height, width, colours + guides), _CODE)
-    _quantize(target_colour, offset[:colours], scale[:colours], target_codes, 0)
-    _quantize(features.in_feature_order(target_guides), offset[colours:], scale[colours:], target_codes, colours)
+    _quantize(target_colour, offset, scale, target_codes, np.arange(colours))
+    _quantize(target_guides, offset, scale, target_codes, features.guide_columns)
     needs_angles = features.use_opposite or orientation_weight > 0
     if needs_angles and (source_angle is None or target_angle is None):
         raise ValueError("the orientation term and opposite-flow swapping need source_angle and target_angle")
@@ -812,18 +810,19 @@ def _channel_max(values):
 
 
 @parallel_kernel
-def _quantize_rows(values, offset, scale, out, first):
+def _quantize_rows(values, offset, scale, out, columns):
     for i in prange(values.shape[0]):
         for c in range(values.shape[1]):
-            code = min(max((values[i, c] - offset[c]) * scale[c], 0.0), _CODE_MAX)
-            out[i, first + c] = int(code + 0.5)
+            code = min(max((values[i, c] - offset[columns[c]]) * scale[columns[c]], 0.0), _CODE_MAX)
+            out[i, columns[c]] = int(code + 0.5)
 
 
-def _quantize(values, offset, scale, codes, first):
-    """Store ``round((values − offset) · scale)``, clipped to the code range, into the
-    features ``first, first + 1, …`` of ``codes`` (shape (..., F), C-contiguous)."""
+def _quantize(values, offset, scale, codes, columns):
+    """Store channel c of ``values`` as ``round((value − offset) · scale)`` of feature
+    ``columns[c]``, clipped to the code range, into ``codes`` (shape (..., F), C-contiguous)."""
     values = np.ascontiguousarray(values, np.float32)
-    _quantize_rows(values.reshape(-1, values.shape[-1]), offset, scale, codes.reshape(-1, codes.shape[-1]), first)
+    _quantize_rows(values.reshape(-1, values.shape[-1]), offset, scale, codes.reshape(-1, codes.shape[-1]),
+                   np.asarray(columns, np.int64))
 
 
 def patch_errors(cost, nnf):

@@ -284,14 +284,16 @@ def _prepare(source_colour, source_guides, guide_weight_map, opposite_guide, sou
     if source_segment is None:
         source_segment = np.zeros((frames, source_height, source_width), np.int32)
     colour = gaussian_pyramid(source_colour, levels)
-    guides = gaussian_pyramid(source_guides, levels)
     angle = _pyramid_or_none(source_angle, levels, downsample_angles)
     segment = _pyramid_or_none(np.asarray(source_segment, np.int32), levels, downsample_labels)
     unvoted = np.zeros(colours)  # the colour before the first vote, and where no patch votes
     prepared = []
+    guides = np.ascontiguousarray(source_guides, np.float32)
     for level, (low, high) in enumerate(ranges):
+        if level:
+            guides = downsample(guides)  # float guides one level at a time: only the codes are kept
         features = quantize_source(
-            colour[level], guides[level], guide_weight_map=guide_weight_map, opposite_guide=opposite_guide,
+            colour[level], guides, guide_weight_map=guide_weight_map, opposite_guide=opposite_guide,
             low=np.concatenate([unvoted, low]), high=np.concatenate([unvoted, high]),
         )
         prepared.append(SourceLevel(colour=colour[level], features=features, angle=angle[level],
