@@ -99,7 +99,7 @@ def _patch_cost(
     if use_opposite:
         centre_angle = source_angle[frame, int(y + 0.5), int(x + 0.5)]
         opposite = math.cos(centre_angle + theta - target_angle[ty, tx]) < 0.0
-    total = 0.0  # float64: the sums of earlier versions, bit for bit
+    total = np.float32(0.0)
     sx = int(x)
     sy = int(y)
     if (
@@ -137,11 +137,50 @@ def _patch_cost(
             if total > bound:
                 return total
         return total
-    return _rotated_cost(
-        source_rows, target_rows, target_weight_rows, swapped_rows, swapped_weight_rows, feature_start, source_angle,
-        target_angle, orientation_weight, orientation_clamp, source_height, source_width, radius,
-        tx, ty, frame, x, y, theta, np.float32(math.cos(theta)), np.float32(math.sin(theta)), opposite, bound,
-    )
+    if theta != 0.0:
+        return _rotated_cost(
+            source_rows, target_rows, target_weight_rows, swapped_rows, swapped_weight_rows, feature_start, source_angle,
+            target_angle, orientation_weight, orientation_clamp, source_height, source_width, radius,
+            tx, ty, frame, x, y, theta, np.float32(math.cos(theta)), np.float32(math.sin(theta)), opposite, bound,
+        )
+    # unturned, but off the integer grid, swapped, with the orientation term or over the source's border
+    cos_t = math.cos(theta)
+    sin_t = math.sin(theta)
+    for dy in range(-radius, radius + 1):
+        qy = ty + dy
+        if qy < 0 or qy >= height:
+            continue
+        for dx in range(-radius, radius + 1):
+            qx = tx + dx
+            if qx < 0 or qx >= width:
+                continue
+            sample_x = x + cos_t * dx - sin_t * dy
+            sample_y = y + sin_t * dx + cos_t * dy
+            x0, y0, x1, y1, w00, w10, w01, w11 = _bilinear_setup(sample_x, sample_y, source_height, source_width)
+            start = feature_start
+            for g in range(-1, groups):
+                end = plain_end if g < 0 else group_ends[g]
+                part = np.float32(0.0)
+                for c in range(start, end):
+                    sc = opposite_feature[c] if opposite else c
+                    value = (
+                        w00 * source[frame, y0, x0, sc]
+                        + w10 * source[frame, y0, x1, sc]
+                        + w01 * source[frame, y1, x0, sc]
+                        + w11 * source[frame, y1, x1, sc]
+                    )
+                    d = value - np.float32(target[qy, qx, c])
+                    part += feature_weights[c] * d * d
+                total += part if g < 0 else weight_maps[g, qy, qx] * part
+                start = max(end, feature_start)
+            if orientation_weight > 0.0:
+                nearest_x = int(min(max(sample_x + 0.5, 0.0), source_width - 1.0))
+                nearest_y = int(min(max(sample_y + 0.5, 0.0), source_height - 1.0))
+                turn = source_angle[frame, nearest_y, nearest_x] + theta - target_angle[qy, qx]
+                total += orientation_weight * min(abs(math.tan(turn)), orientation_clamp)
+        if total > bound:
+            return total
+    return total
 
 
 @inline_kernel
