@@ -20,7 +20,9 @@ has the same segment label; pixels labelled -1 are not synthesized.
 Speed: the random search is bound by cache misses on its far candidates, so each
 pixel draws all its candidates first (boxes around the match after propagation, as
 EbSynth does) and prefetches their data ``PREFETCH_AHEAD`` candidates before comparing
-them; unrotated integer candidates (plain synthesis) go straight to the row-wise SSD.
+them; unrotated integer candidates (plain synthesis) go straight to the row-wise SSD,
+turned ones (flow-aligned synthesis) to a float32 cost whose feature loop vectorizes
+(see :func:`_rotated_cost`).
 
 Parallelism: the target is cut into fixed bands of rows (tiles), processed in parallel.
 Inside a tile, propagation reads the live field; across a tile border it reads the
