@@ -10,7 +10,8 @@ patch distance
 (ext± divided by ``ext_unit``; ext+ and ext− swapped where source and target flows are
 opposite), segment-restricted matching (border/interior), two flow-aligned rotations per
 candidate, and the per-segment 3D uniformity budget. The first synthesized frame starts
-from a random field refined by a guides-only pass; every later frame starts from
+from a random field refined by a guides-only pass, then is synthesized ``settle_passes``
+more times with itself as the previous frame (beyond the paper); every later frame starts from
 ``NNF_prev = SHIFTNNF(NNF_{j−1})``, merged per pyramid level with the upscaled field,
 and its temporal guide is the exemplar voted through ``NNF_prev``, weighted by m(q).
 
@@ -81,6 +82,10 @@ class Params:
         None: ``floor(log2(d_min / n))`` capped so the coarsest level fits 2n + 1.
     reverse : bool
         Synthesize from the last frame to the first (material being added).
+    settle_passes : int
+        Times a fresh start (the first frame processed) is synthesized again with itself
+        as the previous frame, so the next frames do not re-trade its unconverged matches
+        (beyond the paper; docs/stylize.md).
     seed : int
     """
 
@@ -103,6 +108,7 @@ class Params:
     guided_init: bool = True
     pyramid_levels: int | None = None
     reverse: bool = False
+    settle_passes: int = 3
     seed: int = 0
 
     def __post_init__(self):
@@ -123,6 +129,7 @@ class Params:
             ("opt_iters", bool(self.opt_iters) and min(self.opt_iters) >= 0, "a list of counts ≥ 0"),
             ("pm_iters", bool(self.pm_iters) and min(self.pm_iters) >= 0, "a list of counts ≥ 0"),
             ("pyramid_levels", self.pyramid_levels is None or self.pyramid_levels >= 1, "≥ 1"),
+            ("settle_passes", self.settle_passes >= 0, "≥ 0"),
             ("seed", 0 <= self.seed < 2**31, "between 0 and 2^31 − 1"),
         )
         for name, valid, wanted in checks:
@@ -267,11 +274,8 @@ def stylize_sequence(
     )
     guide_weights = np.array([params.w_bound, params.w_ext, params.w_ext] + [params.w_temp] * 3, np.float32)
 
-    for k in steps:
-        index = order[k]
-        frame = target.frame(k)
-        coverage = _coverage(masks(index), (target.height, target.width), index)
-        inside = _inside(frame, coverage)
+    def synthesize_frame(k, frame, inside, previous, settle_pass):
+        """Synthesize processing step k from ``previous`` (None: afresh); return (result, backlog)."""
         segment = np.where(inside, np.maximum(frame.segments.astype(np.int32) - 1, 0), -1).astype(np.int32)
         temp = np.zeros((target.height, target.width, 3), np.float32)
         modulation = np.zeros((1, target.height, target.width), np.float32)
@@ -301,8 +305,21 @@ def stylize_sequence(
                 target_guides=target_guides, colour_weights=np.ones(3, np.float32), guide_weights=guide_weights,
                 weight_maps=modulation, target_angle=frame.direction, target_segment=segment, initial_nnf=initial,
             ),
-            dataclasses.replace(synthesis, seed=int(counter_hash(params.seed, k) % np.uint64(2**31))),
+            dataclasses.replace(synthesis, seed=int(counter_hash(params.seed, k, settle_pass) % np.uint64(2**31))),
         )
+        return result, backlog
+
+    for k in steps:
+        index = order[k]
+        frame = target.frame(k)
+        coverage = _coverage(masks(index), (target.height, target.width), index)
+        inside = _inside(frame, coverage)
+        result, backlog = synthesize_frame(k, frame, inside, previous, 0)
+        if previous is None:
+            # settle a fresh start: resynthesize it with itself as the previous frame (no motion)
+            for settle_pass in range(1, params.settle_passes + 1):
+                result, backlog = synthesize_frame(k, frame, inside, (result.nnf, inside, frame.ext_plus, backlog),
+                                                   settle_pass)
         rgba = np.concatenate([np.clip(result.image, 0.0, 1.0), coverage[..., None]], axis=2)
         previous = (result.nnf, inside, frame.ext_plus, backlog)
         yield StylizedFrame(index=index, rgba=rgba, nnf=result.nnf, mean_error=result.mean_error(), backlog=backlog)

@@ -17,6 +17,7 @@ unshifted; below 1 means the texture travelled).
 """
 
 import argparse
+import dataclasses
 import sys
 import tempfile
 from pathlib import Path
@@ -43,12 +44,12 @@ def _texture_shift(a, b, region):
     return float(shifts[best])
 
 
-def measure_moving(source, frames, speed, workdir):
+def measure_moving(source, frames, speed, workdir, params):
     def moving(j):
         return scene._disk(18 + speed * j)
 
     cache_dir = Path(workdir) / "moving"
-    results = list(stylize.stylize_sequence(moving, frames, source, params=scene.FAST, guide_params=scene.GUIDES,
+    results = list(stylize.stylize_sequence(moving, frames, source, params=params, guide_params=scene.GUIDES,
                                             cache_dir=cache_dir))
     target = guides.GuideCache.open(cache_dir)
     print("frame  ext+inc  |flow|  |Δi|(shift)  backlog  kept  |Δi|(final)  Δx(final)  texture-shift")
@@ -81,14 +82,13 @@ def measure_moving(source, frames, speed, workdir):
     print(f"contrast ratio per frame: {' '.join(f'{c:.2f}' for c in contrast)}")
 
 
-def measure_still(source, frames, workdir):
+def measure_still(source, frames, workdir, params):
     def still(j):
         return scene._disk(scene.SIZE / 2)
 
     def change(temporal_weight, name):
-        params = scene.FAST if temporal_weight is None else scene.FAST.__class__(
-            **{**scene.FAST.__dict__, "w_temp": temporal_weight})
-        results = list(stylize.stylize_sequence(still, frames, source, params=params, guide_params=scene.GUIDES,
+        chosen = params if temporal_weight is None else dataclasses.replace(params, w_temp=temporal_weight)
+        results = list(stylize.stylize_sequence(still, frames, source, params=chosen, guide_params=scene.GUIDES,
                                                 cache_dir=Path(workdir) / name))
         inside = still(0) > 0.5
         return np.mean([np.abs(a.rgba - b.rgba)[inside].mean() for a, b in zip(results, results[1:])])
@@ -104,15 +104,18 @@ def main():
     parser.add_argument("--frames", type=int, default=8)
     parser.add_argument("--speed", type=float, default=1.0)
     parser.add_argument("--still-frames", type=int, default=4)
+    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--settle-passes", type=int, default=scene.FAST.settle_passes)
     args = parser.parse_args()
+    params = dataclasses.replace(scene.FAST, seed=args.seed, settle_passes=args.settle_passes)
     rgb, mask, flow = scene._stain()
     with tempfile.TemporaryDirectory() as workdir:
         cache = guides.compute_guides(lambda j: mask[j], len(mask), params=scene.GUIDES,
                                       cache_dir=Path(workdir) / "source", given_flow=lambda j: flow[j])
         source = stylize.prepare_source(rgb, cache)
-        measure_moving(source, args.frames, args.speed, workdir)
+        measure_moving(source, args.frames, args.speed, workdir, params)
         if args.still_frames > 1:
-            measure_still(source, args.still_frames, workdir)
+            measure_still(source, args.still_frames, workdir, params)
 
 
 if __name__ == "__main__":
