@@ -60,6 +60,7 @@ class Options:
     preview: bool = False
     nnf: bool = False
     quiet: bool = False
+    report: bool = True  # write report.json (commands that only prepare inputs leave the film's report alone)
     force: bool = False  # redo every stage
     force_stages: tuple[str, ...] = ()  # redo these stages
     jobs: int = 1  # layers rendered at once in local processes
@@ -126,7 +127,8 @@ def render(plan: Plan, options: Options) -> Path:
         background_key = run.background()
         if run.last >= STAGES.index("composite"):
             run.composite_and_encode(background_key)
-    run.report.write(run.out / "report.json")
+    if options.report:
+        run.report.write(run.out / "report.json")
     return run.out
 
 

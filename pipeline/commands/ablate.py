@@ -53,7 +53,8 @@ def run(args) -> int:
     plan = scaled_plan(plan_scene(load_scene(args.scene)), args.scale)
     layer = plan.layer(args.layer)
     window = parse_window(args.frames)
-    out = render(plan, Options(until="masks", layers=(layer.name,), window=window, quiet=args.quiet))
+    out = render(plan, Options(until="masks", layers=(layer.name,), window=window, quiet=args.quiet,
+                                 report=False))
     frames = plan.frames(window)
     guide_params = layer_guide_params(plan, layer)
     full = layer_stylize_params(plan, layer)

@@ -133,6 +133,7 @@ def test_ablate_renders_each_term_switched_off_side_by_side(cli, tmp_path, monke
     # w_dir is 0 by default, so "no dir" equals "full" and gets no panel of its own
     assert variants == ["full", "no-bound", "no-dir-bound", "no-ext", "no-temp", "no-uni"]
     assert "no dir: the weight is already 0" in out
+    assert not (tmp_path / "out" / "report.json").exists()  # a film's report is not overwritten by ablate
     full, no_temp = (iio.imread(folder / name / "00001.png") for name in ("full", "no-temp"))
     assert not np.array_equal(full, no_temp)
     with av.open(str(tmp_path / "out" / "ablate" / "blob.mp4")) as container:
