@@ -1,33 +1,19 @@
 """Two renders of one scene at once: both succeed, the work is done once, the cache stays whole."""
 
 import subprocess
-from pathlib import Path
 
 from fluidymation.pipeline.cache import StageCache
 
-ROOT = Path(__file__).parents[2]
+from tests.scenes import blob_scene, write_scene
 
-SCENE = f"""\
-version: 1
-input: {ROOT / "examples/blob/blob.svg"}
-fps: 12
-size: [40, 40]
-frames: {{start: 0, end: 4}}
-output: {{dir: out, video: film.mp4}}
-background: {{type: solid, color: "#f4efe4"}}
-exemplars:
-  ink: {{builtin: watercolor-bloom, size: [32, 32], frames: 6}}
-defaults: {{exemplar: ink, params: {{opt_iters: "2, 1", pm_iters: 2}}}}
-layers:
-  - {{name: blob, color: "#2a6fdb"}}
-"""
+
+SCENE = blob_scene(frames=(0, 4))
 
 
 def test_two_renders_at_once_share_the_work_and_match_a_lone_render(cli, tmp_path, monkeypatch, command_line):
     monkeypatch.setenv("FLUIDYMATION_CACHE", str(tmp_path / "cache"))
     for folder in ("alone", "shared"):
-        (tmp_path / folder).mkdir()
-        (tmp_path / folder / "scene.yaml").write_text(SCENE)
+        write_scene(tmp_path / folder, SCENE)
     assert cli("-q", "render", tmp_path / "alone" / "scene.yaml")[0] == 0
 
     command, env = command_line("--debug", "-q", "render", tmp_path / "shared" / "scene.yaml")

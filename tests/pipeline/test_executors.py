@@ -6,33 +6,17 @@ import sys
 from pathlib import Path
 
 import pytest
-
 from fluidymation.pipeline.cli import main
 
-ROOT = Path(__file__).parents[2]
+from tests.scenes import blob_scene, write_scene
 
-SCENE = f"""\
-version: 1
-input: {ROOT / "examples/blob/blob.svg"}
-fps: 12
-size: [40, 40]
-frames: {{start: 2, end: 5}}
-output: {{dir: out, video: film.mp4}}
-background: {{type: solid, color: "#f4efe4"}}
-exemplars:
-  ink: {{builtin: watercolor-bloom, size: [32, 32], frames: 6}}
-  dry: {{builtin: watercolor-dry, size: [32, 32], frames: 6}}
-defaults: {{exemplar: ink, params: {{opt_iters: "2, 1", pm_iters: 2}}}}
-layers:
-  - {{name: blob, color: "#2a6fdb"}}
-  - {{name: drop, exemplar: dry, blend: over, opacity: 0.5}}
-"""
+
+SCENE = blob_scene(frames=(2, 5), layers='  - {name: blob, color: "#2a6fdb"}\n'
+                                                 "  - {name: drop, exemplar: dry, blend: over, opacity: 0.5}\n")
 
 
 def _render(folder: Path, *options) -> Path:
-    folder.mkdir()
-    (folder / "scene.yaml").write_text(SCENE)
-    assert main(["-q", "render", str(folder / "scene.yaml"), *options]) == 0
+    assert main(["-q", "render", str(write_scene(folder, SCENE)), *options]) == 0
     return folder / "out"
 
 

@@ -6,35 +6,20 @@ import subprocess
 from pathlib import Path
 
 import numpy as np
-
 from fluidymation.engine.nnf import NNF
 from fluidymation.pipeline.cache import StageCache
 from fluidymation.pipeline.resume import FrameStates
 from fluidymation.stages.stylize import StylizedFrame
 
-ROOT = Path(__file__).parents[2]
+from tests.scenes import blob_scene, write_scene
+
 FRAMES = 10
 
-SCENE = f"""\
-version: 1
-input: {ROOT / "examples/blob/blob.svg"}
-fps: 12
-size: [48, 48]
-frames: {{start: 0, end: {FRAMES}}}
-output: {{dir: out, video: film.mp4}}
-background: {{type: solid, color: "#f4efe4"}}
-exemplars:
-  ink: {{builtin: watercolor-bloom, size: [32, 32], frames: 6}}
-defaults: {{exemplar: ink, params: {{opt_iters: "2, 1", pm_iters: 2}}}}
-layers:
-  - {{name: blob, color: "#2a6fdb"}}
-"""
+SCENE = blob_scene(size=48, frames=(0, FRAMES))
 
 
 def _scene(folder: Path) -> Path:
-    folder.mkdir()
-    (folder / "scene.yaml").write_text(SCENE)
-    return folder / "scene.yaml"
+    return write_scene(folder, SCENE)
 
 
 def test_a_killed_render_resumes_without_redoing_frames_and_matches_an_uninterrupted_one(tmp_path, command_line):

@@ -1,33 +1,13 @@
 """The stage cache: unchanged work is never redone, and a change redoes only what depends on it."""
 
 import json
-from pathlib import Path
 
-ROOT = Path(__file__).parents[2]
-
-SCENE = """\
-version: 1
-input: {input}
-fps: 12
-size: [40, 40]
-frames: {{start: 4, end: 7}}
-output: {{dir: out, video: film.mp4}}
-background: {{type: solid, color: "#f4efe4"}}
-exemplars:
-  ink: {{builtin: watercolor-bloom, size: [32, 32], frames: 6}}
-  dry: {{builtin: watercolor-dry, size: [32, 32], frames: 6}}
-defaults: {{exemplar: ink, params: {{opt_iters: "2, 1", pm_iters: 2}}}}
-layers:
-  - {{name: blob, color: "{blob_color}"}}
-  - {{name: drop, exemplar: {drop_exemplar}}}
-"""
+from tests.scenes import blob_scene, write_scene
 
 
 def _write(tmp_path, blob_color="#2a6fdb", drop_exemplar="ink"):
-    scene = tmp_path / "scene.yaml"
-    scene.write_text(SCENE.format(input=ROOT / "examples/blob/blob.svg", blob_color=blob_color,
-                                  drop_exemplar=drop_exemplar))
-    return scene
+    return write_scene(tmp_path, blob_scene(frames=(4, 7), layers=f'  - {{name: blob, color: "{blob_color}"}}\n'
+                                                                   f"  - {{name: drop, exemplar: {drop_exemplar}}}\n"))
 
 
 def _ran(tmp_path):
