@@ -18,7 +18,8 @@ from fluidymation.stages import guides
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 
-def _blob_masks(width, height):
+def blob_masks(width, height):
+    """A wobbling blob of ~150 000 px at 1000×800, moving a few px per frame: ``mask(index)``."""
     yy, xx = np.mgrid[:height, :width].astype(np.float32)
 
     def mask(index):
@@ -41,9 +42,9 @@ def _packed(masks, frames):
 
 def bench_guides(frames, width, height):
     with tempfile.TemporaryDirectory() as cache_dir:
-        warm = _blob_masks(64, 48)
+        warm = blob_masks(64, 48)
         guides.compute_guides(warm, 3, params=guides.Params(), cache_dir=cache_dir + "/warm")
-        masks = _packed(_blob_masks(width, height), frames)
+        masks = _packed(blob_masks(width, height), frames)
         start = time.perf_counter()
         guides.compute_guides(masks, frames, params=guides.Params(), cache_dir=cache_dir)
         elapsed = time.perf_counter() - start

@@ -31,6 +31,7 @@ import time
 from pathlib import Path
 
 import numpy as np
+from bench_guides import blob_masks  # tests/benchmarks is on the path when run as a script
 
 PAPER_SECONDS_PER_FRAME = 1.33
 CASES = {
@@ -51,21 +52,6 @@ def ellipse_masks(width, height, axes=(160.0, 120.0)):
         u = (xx - cx) * np.cos(turn) + (yy - cy) * np.sin(turn)
         v = -(xx - cx) * np.sin(turn) + (yy - cy) * np.cos(turn)
         return (u / axes[0]) ** 2 + (v / axes[1]) ** 2 < 1.0
-
-    return mask
-
-
-def blob_masks(width, height):
-    """A wobbling blob of ~150 000 px moving a few px per frame (as bench_guides.py's)."""
-    yy, xx = np.mgrid[:height, :width].astype(np.float32)
-
-    def mask(index):
-        t = index / 24.0
-        cx = width / 2 + 180 * np.sin(t)
-        cy = height / 2 + 60 * np.cos(1.3 * t)
-        angle = np.arctan2(yy - cy, xx - cx)
-        radius = 220 + 40 * np.sin(3 * angle + t) + 30 * np.sin(t / 2)
-        return np.hypot(xx - cx, yy - cy) < radius
 
     return mask
 
