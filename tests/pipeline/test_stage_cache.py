@@ -5,9 +5,10 @@ import json
 from tests.scenes import blob_scene, write_scene
 
 
-def _write(tmp_path, blob_color="#2a6fdb", drop_exemplar="ink"):
-    return write_scene(tmp_path, blob_scene(frames=(4, 7), layers=f'  - {{name: blob, color: "{blob_color}"}}\n'
-                                                                   f"  - {{name: drop, exemplar: {drop_exemplar}}}\n"))
+def _write(tmp_path, blob_color="#2a6fdb", drop_exemplar="ink", size=40, frames=(4, 7)):
+    return write_scene(tmp_path, blob_scene(size=size, frames=frames,
+                                            layers=f'  - {{name: blob, color: "{blob_color}"}}\n'
+                                                   f"  - {{name: drop, exemplar: {drop_exemplar}}}\n"))
 
 
 def _ran(tmp_path):
@@ -18,7 +19,7 @@ def _ran(tmp_path):
 
 def test_unchanged_scene_recomputes_nothing(cli, tmp_path, monkeypatch):
     monkeypatch.setenv("FLUIDYMATION_CACHE", str(tmp_path / "cache"))
-    scene = _write(tmp_path)
+    scene = _write(tmp_path, size=64, frames=(0, 12))  # a first render long enough (~1 s) to time reliably
     assert cli("-q", "render", scene)[0] == 0
     first_ran, first = _ran(tmp_path)
     video = (tmp_path / "out" / "film.mp4").read_bytes()
