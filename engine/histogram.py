@@ -1,0 +1,101 @@
+"""Histogram matching of a voted target to the exemplar frames it draws from.
+
+Voting averages overlapping patches; where neighbouring matches disagree it blurs, and
+the next search then prefers the exemplar's smoother patches, which blur the next vote
+less: the texture can wash out towards a fixed point of the energy (measured: local
+contrast 0.71–0.98 of the exemplar's depending on the seed alone, equal energies).
+Matching the voted colours' histogram to the exemplar's breaks that loop (histogram
+matching in the voting step, Kopf et al. 2007, thesis section 2.5; here a rank remapping
+of the vote rather than Kopf's reweighting of the contributions). The reference is
+not the whole exemplar but the frames the field draws from, each weighted by its number
+of matches, so a target painted from early (wet) frames keeps their look: per segment
+and channel, the target's values are ranked and replaced by the quantiles of that
+mixture of per-frame distributions.
+
+Each frame's distribution is kept as :data:`QUANTILES` quantiles per segment and
+channel, computed once per source (:func:`quantile_tables`).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+#: Quantiles kept per frame, segment and channel.
+QUANTILES = 64
+
+
+def quantile_tables(colour: np.ndarray, segment: np.ndarray, labels: int) -> np.ndarray:
+    """Every frame's colour distribution per segment label, as quantiles.
+
+    Parameters
+    ----------
+    colour : ndarray, shape (T, H, W, C), float32
+    segment : ndarray, shape (T, H, W), int
+        Labels 0..labels−1; others are ignored.
+    labels : int
+
+    Returns
+    -------
+    ndarray, shape (T, labels, C, QUANTILES), float32
+        NaN where a frame has no pixel of a label.
+    """
+    frames, channels = colour.shape[0], colour.shape[3]
+    levels = (np.arange(QUANTILES) + 0.5) / QUANTILES
+    tables = np.full((frames, labels, channels, QUANTILES), np.nan, np.float32)
+    for frame in range(frames):
+        for label in range(labels):
+            values = colour[frame][segment[frame] == label]
+            if values.size:
+                tables[frame, label] = np.quantile(values, levels, axis=0).T
+    return tables
+
+
+def match_histograms(colour: np.ndarray, nnf_frame: np.ndarray, target_segment: np.ndarray, tables: np.ndarray,
+                     strength: float) -> np.ndarray:
+    """Move a voted image's values towards the distribution of the exemplar frames its matches use.
+
+    Parameters
+    ----------
+    colour : ndarray, shape (H, W, C), float32
+        The vote.
+    nnf_frame : ndarray, shape (H, W), int
+        Matched source frame per pixel (-1: unmatched, left as it is).
+    target_segment : ndarray, shape (H, W), int
+        Segment label per pixel (matches lie in the same segment).
+    tables : ndarray
+        From :func:`quantile_tables` for the same source.
+    strength : float
+        0 keeps the vote, 1 replaces each value by its matched quantile.
+
+    Returns
+    -------
+    ndarray, shape (H, W, C), float32
+        A new image.
+    """
+    out = colour.copy()
+    frames, labels, channels, quantiles = tables.shape
+    matched = (nnf_frame >= 0) & (target_segment >= 0) & (target_segment < labels)
+    for label in range(labels):
+        pixels = matched & (target_segment == label)
+        count = int(pixels.sum())
+        if count == 0:
+            continue
+        uses = np.bincount(nnf_frame[pixels], minlength=frames)[:frames].astype(np.float64)
+        uses[np.isnan(tables[:, label, 0, 0])] = 0.0
+        used = np.flatnonzero(uses)
+        if used.size == 0:
+            continue
+        weights = np.repeat(uses[used] / (uses[used].sum() * quantiles), quantiles)
+        ranks = (np.arange(count) + 0.5) / count  # the quantile each value moves to, by its rank
+        values = out[pixels]
+        for channel in range(channels):
+            pool = tables[used, label, channel].ravel()
+            order = np.argsort(pool, kind="stable")
+            cumulative = np.cumsum(weights[order]) - 0.5 * weights[order]
+            wanted = np.interp(ranks, cumulative, pool[order]).astype(np.float32)
+            ranked = np.argsort(values[:, channel], kind="stable")
+            target = np.empty(count, np.float32)
+            target[ranked] = wanted
+            values[:, channel] += np.float32(strength) * (target - values[:, channel])
+        out[pixels] = values
+    return out

@@ -1,0 +1,65 @@
+"""Histogram matching of a vote to the distribution of the source frames its matches use."""
+
+import numpy as np
+
+from fluidymation.engine.histogram import QUANTILES, match_histograms, quantile_tables
+
+
+def _source():
+    """Two 8×8 frames: frame 0 uniform over [0, 1), frame 1 uniform over [2, 3); label 0 left half, 1 right."""
+    ramp = ((np.arange(64) + 0.5) / 64).reshape(8, 8).astype(np.float32)
+    colour = np.stack([ramp, ramp + 2])[..., None]
+    segment = np.zeros((2, 8, 8), np.int32)
+    segment[:, :, 4:] = 1
+    return colour, segment
+
+
+def test_quantile_tables_per_frame_and_label():
+    colour, segment = _source()
+    segment[1, :, 4:] = -1  # frame 1 has no label-1 pixel
+    tables = quantile_tables(colour, segment, labels=2)
+    assert tables.shape == (2, 2, 1, QUANTILES)
+    left = colour[0][:, :4, 0]
+    np.testing.assert_allclose(tables[0, 0, 0, [0, -1]], np.quantile(left, [0.5 / QUANTILES, 1 - 0.5 / QUANTILES]),
+                               rtol=1e-6)
+    assert np.isnan(tables[1, 1]).all() and not np.isnan(tables[1, 0]).any()
+
+
+def test_values_are_ranked_onto_the_used_frames_distribution():
+    colour, segment = _source()
+    tables = quantile_tables(colour, np.zeros_like(segment), labels=1)
+    # a washed-out vote: 100 values squeezed into [0.45, 0.55], all matched in frame 0
+    vote = np.linspace(0.45, 0.55, 100, dtype=np.float32).reshape(10, 10, 1)
+    frames = np.zeros((10, 10), np.int32)
+    out = match_histograms(vote, frames, np.zeros((10, 10), np.int32), tables, strength=1.0)
+    flat = out.ravel()
+    assert np.all(np.diff(flat) > 0)  # the order is kept
+    # spread over frame 0's [0, 1); the tails stop at the outer kept quantiles (1/128 from the ends)
+    np.testing.assert_allclose(flat[[0, 49, 99]], [0.005, 0.495, 0.995], atol=0.012)
+    half = match_histograms(vote, frames, np.zeros((10, 10), np.int32), tables, strength=0.5)
+    np.testing.assert_allclose(half, 0.5 * (vote + out), atol=1e-6)
+    np.testing.assert_array_equal(match_histograms(vote, frames, np.zeros((10, 10), np.int32), tables, 0.0), vote)
+
+
+def test_frames_weighted_by_their_matches_and_unmatched_pixels_kept():
+    colour, segment = _source()
+    tables = quantile_tables(colour, np.zeros_like(segment), labels=1)
+    vote = np.arange(16, dtype=np.float32).reshape(4, 4, 1)
+    frames = np.full((4, 4), 1, np.int32)
+    frames[0, :3] = 0  # 3 matches in frame 0, 12 in frame 1, one unmatched pixel
+    frames[0, 3] = -1
+    out = match_histograms(vote, frames, np.zeros((4, 4), np.int32), tables, strength=1.0)
+    assert out[0, 3, 0] == vote[0, 3, 0]
+    matched = np.sort(out[frames >= 0, 0])
+    # the mixture is 1/5 frame 0 ([0, 1)) and 4/5 frame 1 ([2, 3)): the 3 lowest ranks fall in frame 0's range
+    assert np.all(matched[:3] < 1.0) and np.all(matched[3:] >= 2.0)
+
+
+def test_each_segment_matched_on_its_own():
+    colour, segment = _source()
+    colour[:, :, 4:] += 10  # label 1 lives around 10..13
+    tables = quantile_tables(colour, segment, labels=2)
+    vote = np.full((2, 2, 1), 5.0, np.float32)
+    target_segment = np.array([[0, 0], [1, 1]], np.int32)
+    out = match_histograms(vote, np.zeros((2, 2), np.int32), target_segment, tables, strength=1.0)
+    assert np.all(out[0] < 1.0) and np.all((out[1] >= 10.0) & (out[1] < 11.0))
