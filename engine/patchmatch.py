@@ -13,7 +13,7 @@ the n×n window of
   features (e.g. swap ext+ and ext−),
 
 plus, in the search, a per-candidate uniformity penalty looked up in a map over the
-source (:mod:`fluidymation.engine.uniformity`). Summation stops early once the partial
+source (:mod:`fluidymation.engine.uniformity`), times an optional per-target-pixel factor. Summation stops early once the partial
 sum exceeds the current best. A target pixel only matches source patches whose centre
 has the same segment label; pixels labelled -1 are not synthesized.
 
@@ -303,10 +303,10 @@ def _prefetch_candidate(source_rows, source_segment, penalty, use_penalty, frame
 
 
 @kernel
-def _penalty_at(penalty, use_penalty, frame, x, y):
+def _penalty_at(penalty, use_penalty, scale, frame, x, y):
     if not use_penalty:
         return np.float32(0.0)
-    return penalty[frame, int(y + 0.5), int(x + 0.5)]
+    return scale * penalty[frame, int(y + 0.5), int(x + 0.5)]
 
 
 @parallel_kernel
@@ -314,7 +314,7 @@ def _search(
     source, target, source_rows, target_rows, feature_weights, run_weights, feature_start, plain_end, group_ends,
     weight_maps, opposite_feature, source_angle, target_angle, orientation_weight, orientation_clamp, use_opposite,
     radius, target_weight_rows, swapped_rows, swapped_weight_rows,
-    source_segment, target_segment, penalty, use_penalty,
+    source_segment, target_segment, penalty, use_penalty, penalty_scale,
     nnf_frame, nnf_coords, error, start_frame, start_coords,
     rotation_mode, alpha, seed, salt, reverse, tile_rows,
 ):
@@ -346,7 +346,8 @@ def _search(
                 best_y = nnf_coords[ty, tx, 1]
                 best_theta = nnf_coords[ty, tx, 2]
                 best_error = error[ty, tx]
-                best_total = best_error + _penalty_at(penalty, use_penalty, best_frame, best_x, best_y)
+                scale_here = penalty_scale[ty, tx] if use_penalty else np.float32(0.0)
+                best_total = best_error + _penalty_at(penalty, use_penalty, scale_here, best_frame, best_x, best_y)
                 # propagation: the neighbour's patch, shifted by the offset turned by its θ
                 for direction in range(2):
                     nx = tx - step if direction == 0 else tx
@@ -381,7 +382,7 @@ def _search(
                         continue
                     if source_segment[cand_frame, int(cy + 0.5), int(cx + 0.5)] != label:
                         continue
-                    cand_penalty = _penalty_at(penalty, use_penalty, cand_frame, cx, cy)
+                    cand_penalty = _penalty_at(penalty, use_penalty, scale_here, cand_frame, cx, cy)
                     if cand_penalty >= best_total:
                         continue
                     bound = best_total - cand_penalty
@@ -442,7 +443,7 @@ def _search(
                         continue
                     cx = np.float32(cx_int)
                     cy = np.float32(cy_int)
-                    cand_penalty = _penalty_at(penalty, use_penalty, cand_frame, cx, cy)
+                    cand_penalty = _penalty_at(penalty, use_penalty, scale_here, cand_frame, cx, cy)
                     if cand_penalty >= best_total:
                         continue
                     if rotation_mode == ROTATION_FLOW:
@@ -878,8 +879,8 @@ def patch_errors(cost, nnf):
     return out
 
 
-def patchmatch_pass(cost, nnf, error, *, penalty=None, rotation_mode=0, alpha=0.75, seed=0, salt=0,
-                    reverse=False, tile_rows=TILE_ROWS):
+def patchmatch_pass(cost, nnf, error, *, penalty=None, penalty_scale=None, rotation_mode=0, alpha=0.75, seed=0,
+                    salt=0, reverse=False, tile_rows=TILE_ROWS):
     """One PatchMatch iteration (propagation, then random search), in place.
 
     Parameters
@@ -891,6 +892,8 @@ def patchmatch_pass(cost, nnf, error, *, penalty=None, rotation_mode=0, alpha=0.
         :func:`patch_errors` of ``nnf`` under ``cost``; kept up to date in place.
     penalty : ndarray, shape (T, Hs, Ws), float32, optional
         Uniformity cost of a patch centred at each source voxel.
+    penalty_scale : ndarray, shape (H, W), float32, optional
+        Per target pixel factor of ``penalty`` (default 1).
     rotation_mode : int
         ``ROTATION_NONE`` or ``ROTATION_FLOW`` (the two flow-aligned angles).
     alpha : float
@@ -907,8 +910,11 @@ def patchmatch_pass(cost, nnf, error, *, penalty=None, rotation_mode=0, alpha=0.
     use_penalty = penalty is not None
     if penalty is None:
         penalty = np.zeros((1, 1, 1), np.float32)
+    if penalty_scale is None:
+        penalty_scale = np.ones(nnf.shape if use_penalty else (1, 1), np.float32)
     _search(
         *cost.kernel_args(), cost.source_segment, cost.target_segment, penalty, use_penalty,
+        np.ascontiguousarray(penalty_scale, np.float32),
         nnf.frame, nnf.coords, error, nnf.frame.copy(), nnf.coords.copy(),
         int(rotation_mode), float(alpha), int(seed), int(salt), bool(reverse), int(tile_rows),
     )

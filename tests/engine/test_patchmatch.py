@@ -121,6 +121,25 @@ def test_patchmatch_finds_the_exact_nearest_neighbours_of_a_tiny_source():
     np.testing.assert_allclose(error, exact, rtol=1e-4)
 
 
+def test_penalty_scaled_per_target_pixel():
+    # frame 0 costs 100 per patch, frame 1 nothing; target row 0 does not pay the penalty
+    rng = np.random.default_rng(9)
+    cost, source, target, _ = make_cost(rng, frames=2, source=(6, 6), target=(4, 5))
+    penalty = np.zeros((2, 6, 6), np.float32)
+    penalty[0] = 100.0
+    scale = np.ones((4, 5), np.float32)
+    scale[0] = 0.0
+    field = NNF.empty(4, 5)
+    fill_random(field, target_segment=cost.target_segment, source_segment=cost.source_segment, seed=3)
+    error = patch_errors(cost, field)
+    for iteration in range(600):
+        patchmatch_pass(cost, field, error, penalty=penalty, penalty_scale=scale, alpha=0.5, seed=3, salt=iteration,
+                        reverse=iteration % 2 == 1, tile_rows=2)
+    assert np.all(field.frame[1:] == 1)
+    exact = naive_exact_nnf(source, target, np.array([1.0, 0.5, 0.25, 2.0, 3.0]), 5)
+    np.testing.assert_allclose(error[0], exact[0], rtol=1e-4)
+
+
 def test_matches_stay_in_their_segment():
     rng = np.random.default_rng(10)
     source_segment = np.zeros((2, 9, 10), np.int32)
