@@ -8,12 +8,15 @@ coarsest first; the last value repeats for the finer levels.
 
 :func:`synthesize` builds the source's pyramid and 16-bit features for its one target.
 A sequence of targets from one source (the stylize stage's frames) builds them once with
-:func:`prepare_source` and calls :func:`synthesize_prepared` per target; levels with
-few pixels run their kernels on one thread (:func:`fluidymation.engine._jit.threads_for`).
+:func:`prepare_source` and calls :func:`synthesize_prepared` per target; a window sliding
+over a long source keeps the frames it has prepared (:meth:`PreparedSource.frames`,
+:func:`concatenate_prepared`). Levels with few pixels run their kernels on one thread
+(:func:`fluidymation.engine._jit.threads_for`).
 """
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
@@ -226,6 +229,55 @@ class PreparedSource:
     def guide_channels(self):
         return self.levels[0].features.guide_order.shape[0]
 
+    def frames(self, start, stop):
+        """Source frames ``start..stop−1`` (views of this source's arrays, their own segment index)."""
+        return PreparedSource(levels=tuple(
+            SourceLevel(colour=level.colour[start:stop], features=_frame_features(level.features, start, stop),
+                        angle=None if level.angle is None else level.angle[start:stop],
+                        segment=level.segment[start:stop], index=segment_index(level.segment[start:stop]))
+            for level in self.levels))
+
+
+def _frame_features(features, start, stop):
+    return dataclasses.replace(features, codes=features.codes[start:stop])
+
+
+def concatenate_prepared(parts):
+    """Join prepared sources along time, in the order given, into one.
+
+    Lets a sliding window over a long source keep the frames it already prepared and
+    prepare only the frames it gains (per-frame work: the pyramid and quantization act
+    on each frame alone). Every part must have been prepared with the same levels and
+    quantization (e.g. from one ``guide_range`` and ``colour_range`` that cover every
+    frame's values).
+
+    Raises
+    ------
+    ValueError
+        If the parts' levels or quantization differ.
+    """
+    first = parts[0]
+    for part in parts[1:]:
+        if len(part.levels) != len(first.levels) or any(
+                not (np.array_equal(a.features.offset, b.features.offset)
+                     and np.array_equal(a.features.scale, b.features.scale))
+                for a, b in zip(part.levels, first.levels)):
+            raise ValueError("the prepared sources differ in levels or quantization; prepare them with ranges "
+                             "that cover every frame")
+    if len(parts) == 1:
+        return first
+    levels = []
+    for rank, level in enumerate(first.levels):
+        stacked = [part.levels[rank] for part in parts]
+        segment = np.concatenate([item.segment for item in stacked])
+        levels.append(SourceLevel(
+            colour=np.concatenate([item.colour for item in stacked]),
+            features=dataclasses.replace(level.features,
+                                         codes=np.concatenate([item.features.codes for item in stacked])),
+            angle=None if level.angle is None else np.concatenate([item.angle for item in stacked]),
+            segment=segment, index=segment_index(segment)))
+    return PreparedSource(levels=tuple(levels))
+
 
 def _check_source(colour, guides, angle, segment):
     if colour.ndim != 4:
@@ -277,8 +329,10 @@ def _channel_range(values):
     return flat.min(axis=0, initial=np.inf).astype(np.float64), flat.max(axis=0, initial=-np.inf).astype(np.float64)
 
 
-def _prepare(source_colour, source_guides, guide_weight_map, opposite_guide, source_angle, source_segment, ranges):
-    """Prepare ``len(ranges)`` levels; ``ranges[l]`` = the (low, high) guide values level l must cover."""
+def _prepare(source_colour, source_guides, guide_weight_map, opposite_guide, source_angle, source_segment, ranges,
+             colour_range=None):
+    """Prepare ``len(ranges)`` levels; ``ranges[l]`` = the (low, high) guide values level l must cover,
+    ``colour_range`` the (low, high) colour values every level must cover besides 0."""
     levels = len(ranges)
     frames, source_height, source_width, colours = source_colour.shape
     if source_segment is None:
@@ -287,6 +341,9 @@ def _prepare(source_colour, source_guides, guide_weight_map, opposite_guide, sou
     angle = _pyramid_or_none(source_angle, levels, downsample_angles)
     segment = _pyramid_or_none(np.asarray(source_segment, np.int32), levels, downsample_labels)
     unvoted = np.zeros(colours)  # the colour before the first vote, and where no patch votes
+    colour_low, colour_high = (unvoted, unvoted) if colour_range is None else (
+        np.minimum(unvoted, np.asarray(colour_range[0], np.float64).reshape(colours)),
+        np.maximum(unvoted, np.asarray(colour_range[1], np.float64).reshape(colours)))
     prepared = []
     guides = np.ascontiguousarray(source_guides, np.float32)
     for level, (low, high) in enumerate(ranges):
@@ -294,7 +351,7 @@ def _prepare(source_colour, source_guides, guide_weight_map, opposite_guide, sou
             guides = downsample(guides)  # float guides one level at a time: only the codes are kept
         features = quantize_source(
             colour[level], guides, guide_weight_map=guide_weight_map, opposite_guide=opposite_guide,
-            low=np.concatenate([unvoted, low]), high=np.concatenate([unvoted, high]),
+            low=np.concatenate([colour_low, low]), high=np.concatenate([colour_high, high]),
         )
         prepared.append(SourceLevel(colour=colour[level], features=features, angle=angle[level],
                                     segment=segment[level], index=segment_index(segment[level])))
@@ -302,7 +359,7 @@ def _prepare(source_colour, source_guides, guide_weight_map, opposite_guide, sou
 
 
 def prepare_source(source_colour, source_guides, *, guide_weight_map=None, opposite_guide=None, source_angle=None,
-                   source_segment=None, guide_range=None, params=SynthesisParams()):
+                   source_segment=None, guide_range=None, colour_range=None, params=SynthesisParams()):
     """Build a source's pyramid and quantized features once, for many :func:`synthesize_prepared` calls.
 
     Parameters
@@ -312,6 +369,10 @@ def prepare_source(source_colour, source_guides, *, guide_weight_map=None, oppos
     guide_range : (low, high), each array-like of shape (G,), optional
         Values the targets' guides may take besides the source's own: the features are
         quantized over the union, target values outside it are clipped to it.
+    colour_range : (low, high), each array-like of shape (Cc,), optional
+        Colour values to quantize over besides the source's own (and 0). With both
+        ranges covering every frame's values, sources prepared from different frames
+        share one quantization and can be joined (:func:`concatenate_prepared`).
     params : SynthesisParams
         Its ``patch_size`` and ``pyramid_levels`` decide the levels prepared.
 
@@ -329,7 +390,7 @@ def prepare_source(source_colour, source_guides, *, guide_weight_map=None, oppos
     low = np.asarray(low, np.float64).reshape(guides)
     high = np.asarray(high, np.float64).reshape(guides)
     return _prepare(source_colour, source_guides, guide_weight_map, opposite_guide, source_angle, source_segment,
-                    [(low, high)] * levels)
+                    [(low, high)] * levels, colour_range)
 
 
 def _level_count(source_shape, target_shape, params):

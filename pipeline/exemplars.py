@@ -6,7 +6,9 @@ A layer names its exemplar with ``exemplar:`` (its own or the scene defaults'); 
 a flow estimated from the masks (``flow: masks``, the default) or from the frames
 (``flow: motion``). With no name the built-in ``watercolor-bloom`` with its default
 parameters is used. Generated built-in exemplars and all exemplar guides are kept under
-:func:`fluidymation.pipeline.paths.cache_dir`.
+:func:`fluidymation.pipeline.paths.cache_dir`; an exemplar's colour is stored beside its
+guides, so a stage reads from disk only the exemplar frames it needs
+(:class:`fluidymation.stages.stylize.StoredSource`) and a cached exemplar is not loaded whole.
 """
 
 from __future__ import annotations
@@ -17,6 +19,7 @@ import json
 import os
 import shutil
 import tempfile
+from pathlib import Path
 
 from fluidymation.errors import SceneError, StageError
 from fluidymation.pipeline import paths
@@ -90,21 +93,28 @@ def exemplar_identity(plan: Plan, layer: PlannedLayer) -> str:
     return _recording_identity(user_params(plan, name, spec), spec)
 
 
-def layer_source(plan: Plan, layer: PlannedLayer, guide_params: guides.Params, *, progress=None) -> stylize.Source:
-    """The layer's exemplar and its guides, generated on first use and cached.
+def layer_source(plan: Plan, layer: PlannedLayer, guide_params: guides.Params, *,
+                 progress=None) -> stylize.StoredSource:
+    """The layer's exemplar and its guides on disk, generated on first use and cached.
 
     ``progress`` is called with no arguments after each simulated exemplar frame.
     """
     name, spec = exemplar_spec(plan, layer)
-    if spec["kind"] == "builtin":
-        exemplar = exemplar_builtin.make_builtin_exemplar(builtin_params(plan, name, spec),
-                                                          cache_dir=paths.exemplar_cache_dir(), progress=progress)
-        rgb, masks, flow = exemplar.rgb, exemplar.mask, exemplar.flow
-    else:
-        recording = exemplar_user.load_user_exemplar(user_params(plan, name, spec))
-        rgb, masks = recording.rgb, recording.mask
-        flow = exemplar_user.motion_flow(rgb, seed=spec.get("seed", 0)) if spec.get("flow") == "motion" else None
-    return _with_guides(rgb, masks, flow, exemplar_identity(plan, layer), guide_params)
+    identity = exemplar_identity(plan, layer)
+    record = json.dumps({"exemplar": identity, "guides": dataclasses.asdict(guide_params), "version": guides.VERSION,
+                         "colour": stylize.StoredSource.COLOUR_FILE}, sort_keys=True)
+    entry = paths.exemplar_guides_cache_dir() / f"{identity}-{hashlib.sha256(record.encode()).hexdigest()[:12]}"
+    if not (entry / "done").is_file():
+        if spec["kind"] == "builtin":
+            exemplar = exemplar_builtin.make_builtin_exemplar(builtin_params(plan, name, spec),
+                                                              cache_dir=paths.exemplar_cache_dir(), progress=progress)
+            rgb, masks, flow = exemplar.rgb, exemplar.mask, exemplar.flow
+        else:
+            recording = exemplar_user.load_user_exemplar(user_params(plan, name, spec))
+            rgb, masks = recording.rgb, recording.mask
+            flow = exemplar_user.motion_flow(rgb, seed=spec.get("seed", 0)) if spec.get("flow") == "motion" else None
+        _store_with_guides(entry, record, rgb, masks, flow, guide_params)
+    return stylize.StoredSource(entry)
 
 
 def _recording_identity(params: exemplar_user.Params, spec: dict) -> str:
@@ -115,24 +125,21 @@ def _recording_identity(params: exemplar_user.Params, spec: dict) -> str:
     return "recording-" + hashlib.sha256(record.encode()).hexdigest()[:16]
 
 
-def _with_guides(rgb, masks, flow, identity: str, guide_params: guides.Params) -> stylize.Source:
-    """The exemplar's guides from the cache, computed (from ``flow``, or the masks) on first use."""
-    record = json.dumps({"exemplar": identity, "guides": dataclasses.asdict(guide_params),
-                         "version": guides.VERSION}, sort_keys=True)
-    entry = paths.exemplar_guides_cache_dir() / f"{identity}-{hashlib.sha256(record.encode()).hexdigest()[:12]}"
-    if not (entry / "done").is_file():
-        entry.parent.mkdir(parents=True, exist_ok=True)
-        staging = tempfile.mkdtemp(prefix=f".{entry.name}.", dir=entry.parent)
+def _store_with_guides(entry: Path, record: str, rgb, masks, flow, guide_params: guides.Params) -> None:
+    """Compute the exemplar's guides (from ``flow``, or the masks) and store them with its colour in ``entry``,
+    marked done with ``record``."""
+    entry.parent.mkdir(parents=True, exist_ok=True)
+    staging = tempfile.mkdtemp(prefix=f".{entry.name}.", dir=entry.parent)
+    try:
+        guides.compute_guides(lambda j: masks[j], len(masks), params=guide_params, cache_dir=staging,
+                              given_flow=None if flow is None else (lambda j: flow[j]))
+        stylize.store_colour(rgb, staging)
+        with open(f"{staging}/done", "w") as handle:
+            handle.write(record)
         try:
-            guides.compute_guides(lambda j: masks[j], len(masks), params=guide_params, cache_dir=staging,
-                                  given_flow=None if flow is None else (lambda j: flow[j]))
-            with open(f"{staging}/done", "w") as handle:
-                handle.write(record)
-            try:
-                os.replace(staging, entry)
-            except OSError:
-                if not (entry / "done").is_file():  # not a concurrent writer that finished first
-                    raise
-        finally:
-            shutil.rmtree(staging, ignore_errors=True)
-    return stylize.prepare_source(rgb, guides.GuideCache.open(entry))
+            os.replace(staging, entry)
+        except OSError:
+            if not (entry / "done").is_file():  # not a concurrent writer that finished first
+                raise
+    finally:
+        shutil.rmtree(staging, ignore_errors=True)

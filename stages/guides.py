@@ -91,6 +91,17 @@ class Params:
                 raise StageError(f"guides: parameter {name} must be {wanted}, got {getattr(self, name)!r}")
 
 
+def map_frames(path: str | os.PathLike, start: int, stop: int, frame_shape: tuple, mode: str = "r") -> np.memmap:
+    """Frames ``start..stop−1`` of a raw float32 file of equally shaped frames stored back to back, mapped.
+
+    Delete the mapping once done with it: the pages it touched then leave the process's
+    resident memory, so reading a long file piece by piece keeps memory bounded.
+    """
+    frame_bytes = int(np.prod(frame_shape)) * 4
+    return np.memmap(path, dtype=np.float32, mode=mode, offset=start * frame_bytes,
+                     shape=(stop - start,) + tuple(frame_shape))
+
+
 class FrameGuides(NamedTuple):
     """The guidance channels of one frame; ``(H, W)`` unless noted."""
 
@@ -156,8 +167,7 @@ class GuideCache:
             raise IndexError(f"frame {index} outside 0..{self.frame_count - 1}")
         depth = self.CHANNELS[channel]
         shape = (self.height, self.width, depth) if depth > 1 else (self.height, self.width)
-        frame_bytes = self.height * self.width * depth * 4
-        return np.memmap(self._path(channel), dtype=np.float32, mode=mode, offset=index * frame_bytes, shape=shape)
+        return map_frames(self._path(channel), index, index + 1, shape, mode)[0]
 
     def write(self, channel: str, index: int, array: np.ndarray) -> None:
         view = self._map(channel, index, "r+")

@@ -24,14 +24,16 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass
-from typing import Callable, Iterator, NamedTuple
+from pathlib import Path
+from typing import Callable, Iterator, NamedTuple, Union
 
 import numpy as np
 
+from fluidymation.engine import distance
 from fluidymation.engine.nnf import NNF
 from fluidymation.engine.random import counter_hash
 from fluidymation.engine.shiftnnf import shift_nnf, temporal_modulation
-from fluidymation.engine.synthesis import SynthesisParams, TargetInputs, synthesize_prepared
+from fluidymation.engine.synthesis import SynthesisParams, TargetInputs, concatenate_prepared, synthesize_prepared
 from fluidymation.engine.synthesis import prepare_source as prepare_engine_source
 from fluidymation.engine.vote import vote
 from fluidymation.errors import StageError
@@ -86,6 +88,11 @@ class Params:
         Times a fresh start (the first frame processed) is synthesized again with itself
         as the previous frame, so the next frames do not re-trade its unconverged matches
         (beyond the paper; docs/stylize.md).
+    source_window : int or None
+        Exemplar frames held and searched at a time (None: all). The window slides evenly
+        from the exemplar's first frames at the first processing step to its last frames
+        at the last step (:func:`window_start`), so memory follows the window, not the
+        exemplar's length (paper section 5; beyond it: docs/stylize.md).
     seed : int
     """
 
@@ -109,6 +116,7 @@ class Params:
     pyramid_levels: int | None = None
     reverse: bool = False
     settle_passes: int = 3
+    source_window: int | None = None
     seed: int = 0
 
     def __post_init__(self):
@@ -130,11 +138,20 @@ class Params:
             ("pm_iters", bool(self.pm_iters) and min(self.pm_iters) >= 0, "a list of counts ≥ 0"),
             ("pyramid_levels", self.pyramid_levels is None or self.pyramid_levels >= 1, "≥ 1"),
             ("settle_passes", self.settle_passes >= 0, "≥ 0"),
+            ("source_window", self.source_window is None or (
+                isinstance(self.source_window, (int, np.integer)) and not isinstance(self.source_window, bool)
+                and self.source_window >= self.min_source_window),
+             f"null or a whole number of frames ≥ {self.min_source_window} (2·cuboid_radius + 1, at least 2)"),
             ("seed", 0 <= self.seed < 2**31, "between 0 and 2^31 − 1"),
         )
         for name, valid, wanted in checks:
             if not valid:
                 raise StageError(f"stylize: parameter {name} must be {wanted}, got {getattr(self, name)!r}")
+
+    @property
+    def min_source_window(self) -> int:
+        """The smallest ``source_window``: a patch's uniformity cuboid fits, and SHIFTNNF can move."""
+        return max(2, 2 * int(self.cuboid_radius) + 1)
 
 
 def parameter_names() -> tuple[str, ...]:
@@ -163,14 +180,29 @@ class Source:
     def frame_count(self) -> int:
         return self.rgb.shape[0]
 
+    @property
+    def ext_max(self) -> float:
+        """The largest ext+ or ext− of the exemplar."""
+        return float(max(self.ext_plus.max(), self.ext_minus.max()))
 
-def prepare_source(rgb: np.ndarray, cache: guides.GuideCache) -> Source:
-    """Gather an exemplar's colour and its guides (from :func:`guides.compute_guides`) into a :class:`Source`."""
-    rgb = np.ascontiguousarray(rgb, np.float32)
-    if rgb.ndim != 4 or rgb.shape[3] != 3 or rgb.shape[:3] != (cache.frame_count, cache.height, cache.width):
-        raise StageError(f"stylize: exemplar colour of shape {rgb.shape} does not match its guides "
-                         f"({cache.frame_count} frames of {cache.width}x{cache.height})")
-    frames = [cache.frame(index) for index in range(cache.frame_count)]
+    def window(self, start: int, stop: int) -> Source:
+        """Frames ``start..stop−1`` (views; the source itself for all frames)."""
+        if (start, stop) == (0, self.frame_count):
+            return self
+        return Source(**{field.name: getattr(self, field.name)[start:stop] for field in dataclasses.fields(self)})
+
+
+def _concatenate(parts: list[Source]) -> Source:
+    """Sources joined along time, in order."""
+    if len(parts) == 1:
+        return parts[0]
+    return Source(**{field.name: np.concatenate([getattr(part, field.name) for part in parts])
+                     for field in dataclasses.fields(Source)})
+
+
+def _gather(rgb: np.ndarray, cache: guides.GuideCache, start: int, stop: int) -> Source:
+    """Exemplar frames ``start..stop−1``: their colour ``rgb`` and their guides from ``cache``."""
+    frames = [cache.frame(index) for index in range(start, stop)]
     return Source(
         rgb=rgb,
         dist=np.stack([border_clamped(f.dist, cache.border_width) for f in frames]),
@@ -180,6 +212,86 @@ def prepare_source(rgb: np.ndarray, cache: guides.GuideCache) -> Source:
         angle=np.stack([f.direction for f in frames]),
         segment=np.stack([f.segments.astype(np.int32) - 1 for f in frames]),
     )
+
+
+def prepare_source(rgb: np.ndarray, cache: guides.GuideCache) -> Source:
+    """Gather an exemplar's colour and its guides (from :func:`guides.compute_guides`) into a :class:`Source`."""
+    rgb = np.ascontiguousarray(rgb, np.float32)
+    if rgb.ndim != 4 or rgb.shape[3] != 3 or rgb.shape[:3] != (cache.frame_count, cache.height, cache.width):
+        raise StageError(f"stylize: exemplar colour of shape {rgb.shape} does not match its guides "
+                         f"({cache.frame_count} frames of {cache.width}x{cache.height})")
+    return _gather(rgb, cache, 0, cache.frame_count)
+
+
+class StoredSource:
+    """An exemplar left on disk: its guides cache with its colour stored beside them (:func:`store_colour`).
+
+    :meth:`window` reads only the frames asked for, so a stylize run with a
+    ``source_window`` holds that many frames, whatever the exemplar's length.
+    ``rgb`` and ``segment`` read every frame (for statistics over the whole exemplar).
+    """
+
+    COLOUR_FILE = "rgb.f32"
+
+    def __init__(self, directory):
+        self.cache = guides.GuideCache.open(directory)
+        self._colour = self.cache.directory / self.COLOUR_FILE
+        frame_shape = (self.cache.height, self.cache.width, 3)
+        expected = self.cache.frame_count * int(np.prod(frame_shape)) * 4
+        if not self._colour.is_file() or self._colour.stat().st_size != expected:
+            raise StageError(f"{directory}: no exemplar colour ({self.COLOUR_FILE}) of {self.cache.frame_count} "
+                             f"frames of {self.cache.width}x{self.cache.height} beside the guides")
+        self._frame_shape = frame_shape
+
+    @property
+    def frame_count(self) -> int:
+        return self.cache.frame_count
+
+    @property
+    def ext_max(self) -> float:
+        """The largest ext+ or ext− of the exemplar (from the guides' summary)."""
+        return float(max(self.cache.meta["ext_plus_max"], self.cache.meta["ext_minus_max"]))
+
+    def colour(self, start: int, stop: int) -> np.ndarray:
+        """Colour of frames ``start..stop−1``, (n, Hs, Ws, 3) float32, read through a mapping released at once."""
+        view = guides.map_frames(self._colour, start, stop, self._frame_shape)
+        rgb = np.array(view)
+        del view
+        return rgb
+
+    def window(self, start: int, stop: int) -> Source:
+        """Frames ``start..stop−1`` as a :class:`Source` in memory."""
+        if not 0 <= start < stop <= self.frame_count:
+            raise StageError(f"stylize: exemplar frames {start}:{stop} outside 0:{self.frame_count}")
+        return _gather(self.colour(start, stop), self.cache, start, stop)
+
+    @property
+    def rgb(self) -> np.ndarray:
+        """Every frame's colour, (T, Hs, Ws, 3) float32."""
+        return self.colour(0, self.frame_count)
+
+    @property
+    def segment(self) -> np.ndarray:
+        """Every frame's segment labels, (T, Hs, Ws) int32 (as :class:`Source`)."""
+        return np.stack([distance.segments(self.cache.read("dist", index), border_width=self.cache.border_width)
+                         .astype(np.int32) - 1 for index in range(self.frame_count)])
+
+
+def store_colour(rgb: np.ndarray, directory) -> None:
+    """Write an exemplar's colour (T, Hs, Ws, 3) beside its guides cache in ``directory``, for :class:`StoredSource`."""
+    np.ascontiguousarray(rgb, np.float32).tofile(Path(directory) / StoredSource.COLOUR_FILE)
+
+
+def window_start(step: int, steps: int, exemplar_frames: int, window: int) -> int:
+    """First exemplar frame of the source window at processing step ``step`` of ``steps``.
+
+    The window slides evenly, from the exemplar's first ``window`` frames at step 0 to
+    its last ones at step ``steps − 1`` (rounded to the nearest frame): a pure function of
+    the step, so partial, resumed and whole runs use the same windows.
+    """
+    span = max(exemplar_frames - window, 0)
+    last = max(steps - 1, 1)
+    return (2 * step * span + last) // (2 * last)
 
 
 class StylizedFrame(NamedTuple):
@@ -199,7 +311,7 @@ class StylizedFrame(NamedTuple):
 def stylize_sequence(
     masks: Callable[[int], np.ndarray],
     frame_count: int,
-    source: Source,
+    source: Union[Source, StoredSource],
     *,
     params: Params,
     guide_params: guides.Params,
@@ -216,7 +328,9 @@ def stylize_sequence(
         the alpha channel (soft edges) and, through the guides, the target.
     frame_count : int
         Frames of the whole sequence (the guides span all of them).
-    source : Source
+    source : Source or StoredSource
+        The exemplar; with ``params.source_window`` only the window's frames are read
+        (from a :class:`StoredSource`) and prepared at a time.
     params : Params
     guide_params : guides.Params
         Must be the parameters the source's guides were made with.
@@ -233,7 +347,8 @@ def stylize_sequence(
     Yields
     ------
     StylizedFrame
-        In processing order (descending indices with ``reverse``).
+        In processing order (descending indices with ``reverse``); its NNF numbers
+        exemplar frames from the exemplar's first, whatever the window.
     """
     first, stop = (0, frame_count) if frames is None else frames
     if not 0 <= first < stop <= frame_count:
@@ -261,21 +376,37 @@ def stylize_sequence(
         orientation_weight=params.w_dir, orientation_clamp=params.dir_clamp, rotation="flow", seed=params.seed,
     )
     unit = np.float32(1.0 / params.ext_unit)
-    # the exemplar's pyramid and features, once for every frame; the target's guides span
-    # shape [0, 1], ext± up to the sequence's largest and a temporal guide of exemplar colours (0 where unvoted)
+    # The exemplar's pyramid and features, once for every frame; the target's guides span
+    # shape [0, 1], ext± up to the sequence's largest and a temporal guide of exemplar colours (0 where unvoted).
     ext_max = max(target.meta["ext_plus_max"], target.meta["ext_minus_max"]) * unit
-    prepared = prepare_engine_source(
-        source.rgb, np.concatenate([
-            source.shape[..., None], source.ext_plus[..., None] * unit, source.ext_minus[..., None] * unit, source.rgb,
-        ], axis=3),
-        guide_weight_map=_WEIGHT_MAP, opposite_guide=_OPPOSITE, source_angle=source.angle,
-        source_segment=source.segment, guide_range=([0.0] * 6, [1.0, ext_max, ext_max, 1.0, 1.0, 1.0]),
-        params=synthesis,
-    )
+    window = source.frame_count if params.source_window is None else min(params.source_window, source.frame_count)
+    colour_range, guide_range = None, ([0.0] * 6, [1.0, ext_max, ext_max, 1.0, 1.0, 1.0])
+    if window < source.frame_count:
+        # A sliding window prepares a few frames at a time: quantize every frame over the same
+        # ranges, covering the whole exemplar (colour in [0, 1]) with a margin for the pyramid's rounding.
+        low, high = -_RANGE_MARGIN, 1.0 + _RANGE_MARGIN
+        ext_max = max(ext_max, source.ext_max * float(unit)) * high
+        colour_range, guide_range = ([low] * 3, [high] * 3), ([low] * 6, [high, ext_max, ext_max, high, high, high])
+
+    def prepare(frames: Source):
+        return prepare_engine_source(
+            frames.rgb, np.concatenate([
+                frames.shape[..., None], frames.ext_plus[..., None] * unit, frames.ext_minus[..., None] * unit,
+                frames.rgb,
+            ], axis=3),
+            guide_weight_map=_WEIGHT_MAP, opposite_guide=_OPPOSITE, source_angle=frames.angle,
+            source_segment=frames.segment, guide_range=guide_range, colour_range=colour_range, params=synthesis,
+        )
+
+    held = _SlidingWindow(source, prepare)
     guide_weights = np.array([params.w_bound, params.w_ext, params.w_ext] + [params.w_temp] * 3, np.float32)
 
     def synthesize_frame(k, frame, inside, previous, settle_pass):
-        """Synthesize processing step k from ``previous`` (None: afresh); return (result, backlog)."""
+        """Synthesize processing step k from ``previous`` (None: afresh) in the held window; return (result, backlog).
+
+        NNFs come and go in exemplar frame numbers; inside, they count from the window's start.
+        """
+        exemplar = held.frames
         segment = np.where(inside, np.maximum(frame.segments.astype(np.int32) - 1, 0), -1).astype(np.int32)
         temp = np.zeros((target.height, target.width, 3), np.float32)
         modulation = np.zeros((1, target.height, target.width), np.float32)
@@ -286,31 +417,33 @@ def stylize_sequence(
             # Motion smaller than one source frame's would be lost frame after frame: carry it over.
             wanted = frame.ext_plus - previous_ext_plus + np.where(previous_inside, previous_backlog, 0.0)
             initial, achieved = shift_nnf(
-                previous_nnf, target_motion=wanted, target_angle=frame.direction,
-                source_ext_plus=source.ext_plus, source_ext_minus=source.ext_minus, source_angle=source.angle,
+                held.inside(previous_nnf), target_motion=wanted, target_angle=frame.direction,
+                source_ext_plus=exemplar.ext_plus, source_ext_minus=exemplar.ext_minus, source_angle=exemplar.angle,
             )
             backlog = np.where(initial.frame >= 0, wanted - achieved, 0.0).astype(np.float32)
             if params.w_temp > 0:
-                temp, _ = vote(source.rgb, initial, patch_size=params.patch_size)
+                temp, _ = vote(exemplar.rgb, initial, patch_size=params.patch_size)
                 modulation[0] = temporal_modulation(
-                    initial, target_dist=border_clamped(frame.dist, target.border_width), source_dist=source.dist,
+                    initial, target_dist=border_clamped(frame.dist, target.border_width), source_dist=exemplar.dist,
                     previous_mask=previous_inside, lower=params.m_lower * d, upper=params.m_upper * d,
                 )
         target_guides = np.concatenate([
             frame.shape[..., None], frame.ext_plus[..., None] * unit, frame.ext_minus[..., None] * unit, temp,
         ], axis=2)
         result = synthesize_prepared(
-            prepared,
+            held.prepared,
             TargetInputs(
                 target_guides=target_guides, colour_weights=np.ones(3, np.float32), guide_weights=guide_weights,
                 weight_maps=modulation, target_angle=frame.direction, target_segment=segment, initial_nnf=initial,
             ),
             dataclasses.replace(synthesis, seed=int(counter_hash(params.seed, k, settle_pass) % np.uint64(2**31))),
         )
-        return result, backlog
+        return dataclasses.replace(result, nnf=held.outside(result.nnf)), backlog
 
     for k in steps:
         index = order[k]
+        start = window_start(k, frame_count, source.frame_count, window)
+        held.move(start, start + window)
         frame = target.frame(k)
         coverage = _coverage(masks(index), (target.height, target.width), index)
         inside = _inside(frame, coverage)
@@ -323,6 +456,51 @@ def stylize_sequence(
         rgba = np.concatenate([np.clip(result.image, 0.0, 1.0), coverage[..., None]], axis=2)
         previous = (result.nnf, inside, frame.ext_plus, backlog)
         yield StylizedFrame(index=index, rgba=rgba, nnf=result.nnf, mean_error=result.mean_error(), backlog=backlog)
+
+
+#: Relative margin of the fixed quantization ranges of a sliding source window.
+_RANGE_MARGIN = 1e-3
+
+
+class _SlidingWindow:
+    """The exemplar frames ``start..stop−1`` held at a time: a :class:`Source` and the engine's prepared source.
+
+    Moving keeps the frames the old and new windows share and reads and prepares only
+    the frames gained (the pyramid and quantization act on each frame alone).
+    """
+
+    def __init__(self, source, prepare: Callable):
+        self.source, self.prepare = source, prepare
+        self.start = self.stop = 0
+        self.frames: Source | None = None
+        self.prepared = None
+
+    def move(self, start: int, stop: int) -> None:
+        if (start, stop) == (self.start, self.stop):
+            return
+        kept = (max(start, self.start), min(stop, self.stop))
+        runs = [(start, stop)] if kept[0] >= kept[1] else [(start, kept[0]), kept, (kept[1], stop)]
+        frames, prepared = [], []
+        for first, last in runs:
+            if first >= last:
+                continue
+            if (first, last) == kept:
+                frames.append(self.frames.window(first - self.start, last - self.start))
+                prepared.append(self.prepared.frames(first - self.start, last - self.start))
+            else:
+                frames.append(self.source.window(first, last))
+                prepared.append(self.prepare(frames[-1]))
+        self.frames, self.prepared = _concatenate(frames), concatenate_prepared(prepared)
+        self.start, self.stop = start, stop
+
+    def inside(self, nnf: NNF) -> NNF:
+        """``nnf`` (exemplar frame numbers) in window frame numbers; matches outside the window move to its nearest frame."""
+        frame = np.where(nnf.frame >= 0, np.clip(nnf.frame, self.start, self.stop - 1) - self.start, -1)
+        return NNF(frame.astype(np.int32), nnf.coords)
+
+    def outside(self, nnf: NNF) -> NNF:
+        """``nnf`` (window frame numbers) in exemplar frame numbers."""
+        return NNF(np.where(nnf.frame >= 0, nnf.frame + self.start, -1).astype(np.int32), nnf.coords)
 
 
 def _inside(frame, coverage: np.ndarray) -> np.ndarray:
