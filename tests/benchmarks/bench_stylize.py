@@ -1,6 +1,6 @@
 """Benchmark: the stylize stage at the sizes of issue 6, next to the paper's Table 2.
 
-Run: ``.venv/bin/python tests/benchmarks/bench_stylize.py [--cases speed memory] [--threads 2]
+Run: ``.venv/bin/python tests/benchmarks/bench_stylize.py [--cases speed memory window] [--threads 2]
 [--profile]``.
 
 * speed: a 500×600 target with ~60 000 masked pixels (an ellipse drifting and turning)
@@ -9,6 +9,11 @@ Run: ``.venv/bin/python tests/benchmarks/bench_stylize.py [--cases speed memory]
   s/frame on 2 cores.
 * memory: a 1000×800 target (a wobbling blob) for 40 frames with a 400×222×20 exemplar
   — the thesis's horse (about 9 GiB there). Target: peak RSS < 1 GiB, flat per frame.
+* window: a long exemplar, ``watercolor-bloom`` at 200×200×120, on a 400×300 target (an
+  ellipse of ~23 000 px) for 30 frames, once with ``source_window: 20`` and once with the
+  whole exemplar: the peak RSS follows the window, not the exemplar's length. The
+  exemplar is stored (colour beside its guides, as the pipeline keeps it) before the
+  runs, and each run reads it from disk (``StoredSource``).
 
 Each case runs in its own process with ``NUMBA_NUM_THREADS`` threads. A tiny warm-up
 scene first loads (or compiles) numba's kernels; its time is shown as "warm-up". The
@@ -38,7 +43,10 @@ CASES = {
     # name: target (width, height), frames, exemplar (width, height, frames), shape
     "speed": ((500, 600), 6, (200, 200, 20), "ellipse"),
     "memory": ((1000, 800), 40, (400, 222, 20), "blob"),
+    "window": ((400, 300), 30, (200, 200, 120), "small ellipse"),
 }
+#: the source_window of each run of a case that compares windows (None: the whole exemplar)
+WINDOWS = {"window": (20, None)}
 RSS_EVERY = 5
 
 
@@ -66,8 +74,9 @@ def peak_and_current_rss_mib():
     return fields["VmHWM"], fields["VmRSS"]
 
 
-def exemplar_source(width, height, frames, guide_params, folder):
-    """The built-in ``watercolor-bloom`` at this size with its guides, as a stylize Source."""
+def exemplar_source(width, height, frames, guide_params, folder, *, stored=False):
+    """The built-in ``watercolor-bloom`` at this size with its guides, as a stylize Source (in memory), or
+    with ``stored`` as a StoredSource in ``folder``."""
     from fluidymation.pipeline import paths
     from fluidymation.pipeline.presets import resolve_params
     from fluidymation.stages import exemplar_builtin, guides, stylize
@@ -76,27 +85,42 @@ def exemplar_source(width, height, frames, guide_params, folder):
     exemplar = exemplar_builtin.make_builtin_exemplar(params, cache_dir=paths.exemplar_cache_dir())
     cache = guides.compute_guides(lambda j: exemplar.mask[j], frames, params=guide_params, cache_dir=folder,
                                   given_flow=lambda j: exemplar.flow[j])
-    return stylize.prepare_source(exemplar.rgb, cache)
+    if not stored:
+        return stylize.prepare_source(exemplar.rgb, cache)
+    stylize.store_colour(exemplar.rgb, folder)
+    return stylize.StoredSource(folder)
 
 
-def run_case(name, profile):
-    """Child process: run one case, print one JSON line with its figures."""
+def target_masks(shape, width, height):
+    if shape == "small ellipse":
+        return ellipse_masks(width, height, (100.0, 75.0))
+    return (ellipse_masks if shape == "ellipse" else blob_masks)(width, height)
+
+
+def run_case(name, profile, window=None, stored=None):
+    """Child process: run one case (with ``source_window`` ``window``; the exemplar stored in ``stored``,
+    or generated here), print one JSON line with its figures."""
     from fluidymation.pipeline.parameters import stylize_defaults
     from fluidymation.stages import guides, stylize
 
     (width, height), frame_count, (ex_width, ex_height, ex_frames), shape = CASES[name]
-    params = stylize.Params(**stylize_defaults())
+    params = stylize.Params(**stylize_defaults() | {"source_window": window})
     guide_params = guides.Params()
-    masks = (ellipse_masks if shape == "ellipse" else blob_masks)(width, height)
+    masks = target_masks(shape, width, height)
     with tempfile.TemporaryDirectory() as folder:
         folder = Path(folder)
         started = time.perf_counter()
         small = exemplar_source(48, 48, 6, guide_params, folder / "warm-source")
         for _ in stylize.stylize_sequence(ellipse_masks(64, 64, (20.0, 15.0)), 2, small,
-                                          params=params, guide_params=guide_params, cache_dir=folder / "warm"):
+                                          params=stylize.Params(**stylize_defaults()), guide_params=guide_params,
+                                          cache_dir=folder / "warm"):
             pass
+        del small
         warm_up = time.perf_counter() - started
-        source = exemplar_source(ex_width, ex_height, ex_frames, guide_params, folder / "source")
+        if stored is None:
+            source = exemplar_source(ex_width, ex_height, ex_frames, guide_params, folder / "source")
+        else:
+            source = stylize.StoredSource(stored)
         packed = [np.packbits(masks(j)) for j in range(frame_count)]
         masked = [int(masks(j).sum()) for j in range(frame_count)]
 
@@ -133,22 +157,25 @@ def run_case(name, profile):
                       "peak": peak_and_current_rss_mib()[0], "loads": loads}))
 
 
-def run_child(name, threads, profile):
+def run_child(name, threads, profile, window=None, stored=None):
     env = dict(os.environ, NUMBA_NUM_THREADS=str(threads))
     command = [sys.executable, __file__, "--child", name] + (["--profile"] if profile else [])
+    command += [] if window is None else ["--window", str(window)]
+    command += [] if stored is None else ["--stored", str(stored)]
     result = subprocess.run(command, env=env, stdout=subprocess.PIPE, text=True)
     if result.returncode != 0:
         raise SystemExit(f"case {name} failed ({result.returncode})")
     return json.loads(result.stdout.strip().splitlines()[-1])
 
 
-def report(name, figures, threads):
+def report(name, figures, threads, window=None):
     (width, height), frame_count, (ex_width, ex_height, ex_frames), _ = CASES[name]
     times = np.array(figures["times"])
     masked = np.array(figures["masked"], np.float64)
     later = times[1:] if len(times) > 1 else times
+    held = "" if window is None else f" (source_window {window})"
     print(f"\n{name}: target {width}x{height} px, {frame_count} frames, {masked.mean():.0f} masked px/frame; "
-          f"exemplar {ex_width}x{ex_height}x{ex_frames}; {threads} thread{'s' * (threads > 1)}; load average "
+          f"exemplar {ex_width}x{ex_height}x{ex_frames}{held}; {threads} thread{'s' * (threads > 1)}; load average "
           f"{figures['loads'][0]:.2f} -> {figures['loads'][1]:.2f}")
     print(f"  warm-up (numba load/compile, tiny scene) {figures['warm_up']:.1f} s; target guides of all "
           f"{frame_count} frames {figures['guides']:.1f} s (the stage's first frame includes them)")
@@ -170,12 +197,23 @@ def main():
     parser.add_argument("--threads", type=int, default=2)
     parser.add_argument("--profile", action="store_true", help="print each case's cProfile (cumulative)")
     parser.add_argument("--child", choices=list(CASES), help=argparse.SUPPRESS)
+    parser.add_argument("--window", type=int, help=argparse.SUPPRESS)
+    parser.add_argument("--stored", help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.child:
-        run_case(args.child, args.profile)
+        run_case(args.child, args.profile, args.window, args.stored)
         return
     for name in args.cases:
-        report(name, run_child(name, args.threads, args.profile), args.threads)
+        if name not in WINDOWS:
+            report(name, run_child(name, args.threads, args.profile), args.threads)
+            continue
+        from fluidymation.stages import guides
+
+        _, _, (ex_width, ex_height, ex_frames), _ = CASES[name]
+        with tempfile.TemporaryDirectory() as stored:  # stored here, so no run holds the generated exemplar
+            exemplar_source(ex_width, ex_height, ex_frames, guides.Params(), stored, stored=True)
+            for window in WINDOWS[name]:
+                report(name, run_child(name, args.threads, args.profile, window, stored), args.threads, window)
 
 
 if __name__ == "__main__":
