@@ -17,7 +17,10 @@ and its temporal guide is the exemplar voted through ``NNF_prev``, weighted by m
 
 Frames are processed in order (or from the last to the first with ``reverse``); the
 target guides are computed over the whole sequence in processing order and streamed
-from an on-disk cache, so memory does not grow with the number of frames.
+from an on-disk cache, so memory does not grow with the number of frames. With
+``source_window`` only that many consecutive exemplar frames are read (from a
+:class:`StoredSource`) and prepared at a time, sliding along the exemplar as the frames
+are processed, so memory does not grow with the exemplar's length either.
 """
 
 from __future__ import annotations
@@ -25,7 +28,7 @@ from __future__ import annotations
 import dataclasses
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Callable, Iterator, NamedTuple, Union
+from typing import Callable, Iterator, NamedTuple
 
 import numpy as np
 
@@ -311,7 +314,7 @@ class StylizedFrame(NamedTuple):
 def stylize_sequence(
     masks: Callable[[int], np.ndarray],
     frame_count: int,
-    source: Union[Source, StoredSource],
+    source: Source | StoredSource,
     *,
     params: Params,
     guide_params: guides.Params,
