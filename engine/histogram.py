@@ -50,6 +50,13 @@ def quantile_tables(colour: np.ndarray, segment: np.ndarray, labels: int) -> np.
     return tables
 
 
+def join_tables(parts: list[np.ndarray]) -> np.ndarray:
+    """Tables of consecutive frame ranges joined along time (labels missing from a part are NaN)."""
+    labels = max(part.shape[1] for part in parts)
+    return np.concatenate([np.pad(part, ((0, 0), (0, labels - part.shape[1]), (0, 0), (0, 0)), constant_values=np.nan)
+                           for part in parts])
+
+
 def match_histograms(colour: np.ndarray, nnf_frame: np.ndarray, target_segment: np.ndarray, tables: np.ndarray,
                      strength: float) -> np.ndarray:
     """Move a voted image's values towards the distribution of the exemplar frames its matches use.

@@ -22,6 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from fluidymation.engine._jit import threads_for
+from fluidymation.engine.histogram import join_tables, match_histograms, quantile_tables
 from fluidymation.engine.nnf import (
     NNF, ROTATION_FLOW, ROTATION_NONE, downscale_nnf, fill_random, merge_nnf, segment_index, upscale_nnf,
 )
@@ -60,6 +61,9 @@ class SynthesisParams:
         λ of the uniformity penalty (0 disables it), in the squared units of the features.
     uniformity_radius : int
         r: a patch also occupies the r frames before and after its own.
+    histogram_matching : float
+        Strength (0–1) with which each vote's colour histogram is matched, per segment, to
+        the source frames its matches use (:mod:`fluidymation.engine.histogram`); 0: off.
     orientation_weight, orientation_clamp : float
         Weight and clamp of the ``|tan(S_dir + θ − T_dir)|`` term (needs the angles).
     rotation : {"none", "flow"}
@@ -78,6 +82,7 @@ class SynthesisParams:
     alpha: float = 0.75
     uniformity_weight: float = 0.0
     uniformity_radius: int = 0
+    histogram_matching: float = 0.0
     orientation_weight: float = 0.0
     orientation_clamp: float = 10.0
     rotation: str = "none"
@@ -98,6 +103,8 @@ class SynthesisParams:
             raise ValueError(f"alpha must lie in (0, 1), got {self.alpha}")
         if self.uniformity_weight < 0 or self.uniformity_radius < 0 or self.orientation_weight < 0:
             raise ValueError("uniformity_weight, uniformity_radius and orientation_weight must be ≥ 0")
+        if not 0.0 <= self.histogram_matching <= 1.0:
+            raise ValueError(f"histogram_matching must lie in [0, 1], got {self.histogram_matching}")
         if self.rotation not in _ROTATIONS:
             raise ValueError(f"rotation must be one of {sorted(_ROTATIONS)}, got {self.rotation!r}")
         if self.seed < 0 or self.tile_rows < 1:
@@ -173,7 +180,8 @@ class SynthesisResult:
 @dataclass(frozen=True)
 class TargetInputs:
     """The target side of :func:`synthesize_prepared` (the fields of :class:`SynthesisInputs`
-    that describe the target; ``target_guides`` in the prepared source's guide order)."""
+    that describe the target; ``target_guides`` in the prepared source's guide order), and
+    ``uniformity_scale`` (H, W): a per-pixel factor of the uniformity penalty (default 1)."""
 
     target_guides: np.ndarray
     colour_weights: np.ndarray
@@ -182,6 +190,7 @@ class TargetInputs:
     target_angle: np.ndarray | None = None
     target_segment: np.ndarray | None = None
     initial_nnf: NNF | None = None
+    uniformity_scale: np.ndarray | None = None
 
 
 @dataclass(frozen=True)
@@ -198,6 +207,9 @@ class SourceLevel:
     segment : ndarray, shape (T, Hs, Ws), int32
     index : tuple
         :func:`segment_index` of ``segment``.
+    quantiles : ndarray or None
+        :func:`~fluidymation.engine.histogram.quantile_tables` of ``colour`` (prepared for
+        ``histogram_matching``).
     """
 
     colour: np.ndarray
@@ -205,6 +217,7 @@ class SourceLevel:
     angle: np.ndarray | None
     segment: np.ndarray
     index: tuple
+    quantiles: np.ndarray | None = None
 
 
 @dataclass(frozen=True)
@@ -234,7 +247,8 @@ class PreparedSource:
         return PreparedSource(levels=tuple(
             SourceLevel(colour=level.colour[start:stop], features=_frame_features(level.features, start, stop),
                         angle=None if level.angle is None else level.angle[start:stop],
-                        segment=level.segment[start:stop], index=segment_index(level.segment[start:stop]))
+                        segment=level.segment[start:stop], index=segment_index(level.segment[start:stop]),
+                        quantiles=None if level.quantiles is None else level.quantiles[start:stop])
             for level in self.levels))
 
 
@@ -275,7 +289,8 @@ def concatenate_prepared(parts):
             features=dataclasses.replace(level.features,
                                          codes=np.concatenate([item.features.codes for item in stacked])),
             angle=None if level.angle is None else np.concatenate([item.angle for item in stacked]),
-            segment=segment, index=segment_index(segment)))
+            segment=segment, index=segment_index(segment),
+            quantiles=None if level.quantiles is None else join_tables([item.quantiles for item in stacked])))
     return PreparedSource(levels=tuple(levels))
 
 
@@ -296,7 +311,8 @@ def _check_target(target, colours, guides):
     height, width = target_guides.shape[:2]
     if np.shape(target.colour_weights) != (colours,) or np.shape(target.guide_weights) != (guides,):
         raise ValueError("colour_weights and guide_weights need one weight per channel")
-    shapes = {"weight_maps": (None, height, width), "target_angle": (height, width), "target_segment": (height, width)}
+    shapes = {"weight_maps": (None, height, width), "target_angle": (height, width), "target_segment": (height, width),
+              "uniformity_scale": (height, width)}
     for name, shape in shapes.items():
         value = getattr(target, name)
         if value is not None and (value.ndim != len(shape)
@@ -330,9 +346,10 @@ def _channel_range(values):
 
 
 def _prepare(source_colour, source_guides, guide_weight_map, opposite_guide, source_angle, source_segment, ranges,
-             colour_range=None):
+             colour_range=None, histograms=False):
     """Prepare ``len(ranges)`` levels; ``ranges[l]`` = the (low, high) guide values level l must cover,
-    ``colour_range`` the (low, high) colour values every level must cover besides 0."""
+    ``colour_range`` the (low, high) colour values every level must cover besides 0; ``histograms``:
+    also each level's quantile tables."""
     levels = len(ranges)
     frames, source_height, source_width, colours = source_colour.shape
     if source_segment is None:
@@ -353,8 +370,11 @@ def _prepare(source_colour, source_guides, guide_weight_map, opposite_guide, sou
             colour[level], guides, guide_weight_map=guide_weight_map, opposite_guide=opposite_guide,
             low=np.concatenate([colour_low, low]), high=np.concatenate([colour_high, high]),
         )
+        tables = None
+        if histograms:
+            tables = quantile_tables(colour[level], segment[level], int(segment[level].max(initial=-1)) + 1)
         prepared.append(SourceLevel(colour=colour[level], features=features, angle=angle[level],
-                                    segment=segment[level], index=segment_index(segment[level])))
+                                    segment=segment[level], index=segment_index(segment[level]), quantiles=tables))
     return PreparedSource(levels=tuple(prepared))
 
 
@@ -390,7 +410,7 @@ def prepare_source(source_colour, source_guides, *, guide_weight_map=None, oppos
     low = np.asarray(low, np.float64).reshape(guides)
     high = np.asarray(high, np.float64).reshape(guides)
     return _prepare(source_colour, source_guides, guide_weight_map, opposite_guide, source_angle, source_segment,
-                    [(low, high)] * levels, colour_range)
+                    [(low, high)] * levels, colour_range, histograms=params.histogram_matching > 0)
 
 
 def _level_count(source_shape, target_shape, params):
@@ -426,7 +446,8 @@ def synthesize(inputs, params=SynthesisParams()):
     levels = _level_count(source_colour.shape[1:3], target.target_guides.shape[:2], params)
     target_guides = gaussian_pyramid(target.target_guides, levels)
     source = _prepare(source_colour, source_guides, inputs.guide_weight_map, inputs.opposite_guide,
-                      inputs.source_angle, inputs.source_segment, [_channel_range(level) for level in target_guides])
+                      inputs.source_angle, inputs.source_segment, [_channel_range(level) for level in target_guides],
+                      histograms=params.histogram_matching > 0)
     return _synthesize(source, target, params, target_guides)
 
 
@@ -462,6 +483,7 @@ def _synthesize(source, target, params, target_guides):
     if target_segment is None:
         target_segment = np.zeros((height, width), np.int32)
     weight_maps = _pyramid_or_none(target.weight_maps, levels, _downsample_maps)
+    uniformity_scales = _pyramid_or_none(target.uniformity_scale, levels, lambda scale: _downsample_maps(scale[None])[0])
     target_angle = _pyramid_or_none(target.target_angle, levels, downsample_angles)
     target_segments = _pyramid_or_none(np.asarray(target_segment, np.int32), levels, downsample_labels)
     nnf = None
@@ -472,6 +494,7 @@ def _synthesize(source, target, params, target_guides):
                 source.levels[level], target, params, rank=rank, level=level, nnf=nnf,
                 optimise=not (level == 0 and levels > 1 and params.vote_only_finest), target_guides=target_guides[level],
                 weight_maps=weight_maps[level], target_angle=target_angle[level], target_segment=target_segments[level],
+                uniformity_scale=uniformity_scales[level],
             )
     with threads_for(height * width):
         error = patch_errors(cost, nnf)
@@ -479,7 +502,7 @@ def _synthesize(source, target, params, target_guides):
 
 
 def _synthesize_level(prepared, target, params, *, rank, level, nnf, optimise, target_guides, weight_maps, target_angle,
-                      target_segment):
+                      target_segment, uniformity_scale):
     """One pyramid level: start from ``nnf`` (the coarser level's, or None), return (nnf, colour, cost)."""
     rotation_mode = _ROTATIONS[params.rotation]
     level_height, level_width = target_guides.shape[:2]
@@ -501,6 +524,11 @@ def _synthesize_level(prepared, target, params, *, rank, level, nnf, optimise, t
 
     def revote():
         colour, _ = vote(prepared.colour, nnf, patch_size=params.patch_size)
+        if params.histogram_matching > 0:
+            if prepared.quantiles is None:
+                raise ValueError("histogram_matching needs a source prepared with it")
+            colour = match_histograms(colour, nnf.frame, cost.target_segment, prepared.quantiles,
+                                      params.histogram_matching)
         cost.set_target_colour(colour)
         return colour
 
@@ -548,7 +576,8 @@ def _synthesize_level(prepared, target, params, *, rank, level, nnf, optimise, t
                                             patch_size=params.patch_size, frame_radius=params.uniformity_radius)
                 penalty = uniformity_penalty(occurrence, source_segment=cost.source_segment, scales=scales,
                                              patch_size=params.patch_size)
-            patchmatch_pass(cost, nnf, error, penalty=penalty, rotation_mode=rotation_mode, alpha=params.alpha,
+            patchmatch_pass(cost, nnf, error, penalty=penalty, penalty_scale=uniformity_scale,
+                            rotation_mode=rotation_mode, alpha=params.alpha,
                             seed=params.seed, salt=_salt(level, 3, em, iteration), reverse=iteration % 2 == 1,
                             tile_rows=params.tile_rows)
         colour = revote()

@@ -67,6 +67,13 @@ class Params:
         colour SSD (sRGB in [0, 1]); the penalty weight is ``w_uni · λ``.
     cuboid_radius : int
         r, frames before and after a patch that count as used (uniformity).
+    uni_carried : float
+        Factor of the uniformity penalty where the temporal term holds (m(q) = 1): the
+        penalty is scaled by ``1 − (1 − uni_carried)·m(q)``, so paint carried over from the
+        previous frame is not re-spread frame after frame (1: the paper; beyond it, docs/stylize.md).
+    histogram_matching : float
+        Strength (0–1) of matching each vote's colour histogram to the exemplar frames its
+        matches use, against wash-out (beyond the paper; docs/stylize.md).
     m_lower, m_upper : float
         Temporal modulation bounds as fractions of d, the larger target side: m = 1
         where the (border-clamped) distances differ by ≤ m_lower·d, 0 by ≥ m_upper·d.
@@ -107,6 +114,8 @@ class Params:
     w_uni: float = 1.0
     uniformity_lambda: float = 0.3
     cuboid_radius: int = 5
+    uni_carried: float = 0.0
+    histogram_matching: float = 1.0
     m_lower: float = 0.01
     m_upper: float = 0.1
     ext_unit: float = 10.0
@@ -134,6 +143,8 @@ class Params:
             ("w_dir", self.w_dir >= 0, "≥ 0"), ("w_temp", self.w_temp >= 0, "≥ 0"),
             ("w_uni", self.w_uni >= 0, "≥ 0"), ("uniformity_lambda", self.uniformity_lambda >= 0, "≥ 0"),
             ("cuboid_radius", self.cuboid_radius >= 0, "≥ 0"),
+            ("uni_carried", 0 <= self.uni_carried <= 1, "between 0 and 1"),
+            ("histogram_matching", 0 <= self.histogram_matching <= 1, "between 0 and 1"),
             ("m_lower", 0 <= self.m_lower <= self.m_upper, "between 0 and m_upper"),
             ("ext_unit", self.ext_unit > 0, "positive"), ("dir_clamp", self.dir_clamp > 0, "positive"),
             ("alpha", 0 < self.alpha < 1, "between 0 and 1 (exclusive)"),
@@ -376,7 +387,7 @@ def stylize_sequence(
         patchmatch_iters=params.pm_iters, vote_only_finest=params.vote_only_finest,
         guided_initialization=params.guided_init, alpha=params.alpha,
         uniformity_weight=params.w_uni * params.uniformity_lambda, uniformity_radius=params.cuboid_radius,
-        orientation_weight=params.w_dir, orientation_clamp=params.dir_clamp, rotation="flow", seed=params.seed,
+        histogram_matching=params.histogram_matching, orientation_weight=params.w_dir, orientation_clamp=params.dir_clamp, rotation="flow", seed=params.seed,
     )
     unit = np.float32(1.0 / params.ext_unit)
     # The exemplar's pyramid and features, once for every frame; the target's guides span
@@ -438,6 +449,7 @@ def stylize_sequence(
             TargetInputs(
                 target_guides=target_guides, colour_weights=np.ones(3, np.float32), guide_weights=guide_weights,
                 weight_maps=modulation, target_angle=frame.direction, target_segment=segment, initial_nnf=initial,
+                uniformity_scale=1.0 - (1.0 - np.float32(params.uni_carried)) * modulation[0],
             ),
             dataclasses.replace(synthesis, seed=int(counter_hash(params.seed, k, settle_pass) % np.uint64(2**31))),
         )

@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from fluidymation.engine.histogram import QUANTILES, match_histograms, quantile_tables
+from fluidymation.engine.histogram import QUANTILES, join_tables, match_histograms, quantile_tables
 
 
 def _source():
@@ -63,3 +63,15 @@ def test_each_segment_matched_on_its_own():
     target_segment = np.array([[0, 0], [1, 1]], np.int32)
     out = match_histograms(vote, np.zeros((2, 2), np.int32), target_segment, tables, strength=1.0)
     assert np.all(out[0] < 1.0) and np.all((out[1] >= 10.0) & (out[1] < 11.0))
+
+
+def test_tables_of_frame_ranges_join_into_the_whole():
+    colour, segment = _source()
+    whole = quantile_tables(colour, segment, labels=2)
+    first = quantile_tables(colour[:1], segment[:1], labels=2)
+    segment[1] = 0  # the second part has only label 0
+    second = quantile_tables(colour[1:], segment[1:], labels=1)
+    joined = join_tables([first, second])
+    assert joined.shape == whole.shape
+    np.testing.assert_array_equal(joined[0], whole[0])
+    assert np.isnan(joined[1, 1]).all()

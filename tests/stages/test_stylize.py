@@ -93,10 +93,8 @@ def test_texture_moves_with_the_shape(source, tmp_path):
     assert np.abs(np.roll(first, 4, axis=1) - last)[both].mean() < 0.5 * np.abs(first - last)[both].mean()
 
 
-@pytest.mark.xfail(reason="open (issue 6): the first frame's local contrast depends on the seed (0.75-0.92 of the "
-                          "exemplar's over seeds 0-7; seed 0 is the worst, 0.75) and later frames keep it; "
-                          "see docs/stylize.md")
 def test_texture_is_not_washed_out(source, tmp_path):
+    # measured 1.00-1.02 of the exemplar's with histogram matching (0.71-0.92 over seeds without)
     frames = _run(moving, 5, source, tmp_path)
     exemplar_contrast = np.mean([_local_contrast(source.rgb[i], source.segment[i] >= 0)
                                  for i in range(source.frame_count)])
