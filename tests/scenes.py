@@ -1,6 +1,10 @@
-"""Tiny scenes of the blob example for pipeline tests: quick to render, real end to end."""
+"""Tiny scenes of the blob example for pipeline tests (quick to render, real end to end), and
+tiny masks and exemplars for the stylize tests."""
 
 from pathlib import Path
+
+import numpy as np
+from scipy import ndimage
 
 ROOT = Path(__file__).parents[1]
 BLOB_ONLY = '  - {name: blob, color: "#2a6fdb"}\n'
@@ -24,3 +28,25 @@ def write_scene(folder: Path, text: str) -> Path:
     folder.mkdir(parents=True, exist_ok=True)
     (folder / "scene.yaml").write_text(text)
     return folder / "scene.yaml"
+
+
+def disk(size: int, radius: float, centre_x: float | None = None) -> np.ndarray:
+    """A soft-edged disk's coverage on a ``size``² frame, (size, size) float32, centred vertically."""
+    centre_x = size / 2 if centre_x is None else centre_x
+    yy, xx = np.mgrid[:size, :size] + 0.5
+    return np.clip(radius - np.hypot(yy - size / 2, xx - centre_x) + 0.5, 0, 1).astype(np.float32)
+
+
+def drifting_disk(j: int, size: int = 32) -> np.ndarray:
+    """Frame ``j`` of a disk that grows 0.7 px and drifts 0.6 px a frame (a tiny stylize target)."""
+    return disk(size, 8.0 + 0.7 * j, centre_x=size / 2 - 3 + 0.6 * j)
+
+
+def spreading_wash(*, size: int, frames: int, seed: int, start_radius: float, growth: float):
+    """A blotchy blue wash whose disk grows ``growth`` px a frame: rgb (T, size, size, 3) float32, mask (T, size, size)."""
+    rng = np.random.default_rng(seed)
+    texture = ndimage.gaussian_filter(rng.standard_normal((frames, size, size)), (0, 1.5, 1.5))
+    mask = np.stack([disk(size, start_radius + growth * t) > 0.5 for t in range(frames)])
+    density = np.clip(0.55 + 0.3 * texture / texture.std(), 0, 1) * mask
+    rgb = (0.95 * (1 - density[..., None]) + np.array([0.2, 0.45, 0.85]) * density[..., None]).astype(np.float32)
+    return rgb, mask

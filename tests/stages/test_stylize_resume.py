@@ -4,42 +4,29 @@ import dataclasses
 
 import numpy as np
 import pytest
-from scipy import ndimage
 
 from fluidymation.engine.nnf import NNF
 from fluidymation.errors import StageError
 from fluidymation.stages import guides, stylize
+from tests.scenes import drifting_disk, spreading_wash
 
 SIZE = 32
 GUIDES = guides.Params(blur_sigma=1.5, shape_radius=6, border_width=3, dist_time_sigma=0.5, flow_time_radius=1)
 PARAMS = stylize.Params(opt_iters=(2, 1), pm_iters=(2,), vote_only_finest=False)
 
 
-def _disk(radius, centre_x=SIZE / 2):
-    yy, xx = np.mgrid[:SIZE, :SIZE] + 0.5
-    return np.clip(radius - np.hypot(yy - SIZE / 2, xx - centre_x) + 0.5, 0, 1).astype(np.float32)
-
-
-def _moving(j):
-    return _disk(8.0 + 0.7 * j, centre_x=SIZE / 2 - 3 + 0.6 * j)
-
-
 @pytest.fixture(scope="module")
 def source(tmp_path_factory):
     """A blotchy blue wash spreading 1.5 px a frame, 6 frames of 32 px."""
-    rng = np.random.default_rng(3)
-    texture = ndimage.gaussian_filter(rng.standard_normal((6, SIZE, SIZE)), (0, 1.5, 1.5))
-    mask = np.stack([_disk(6.0 + 1.5 * t) > 0.5 for t in range(6)])
-    density = np.clip(0.55 + 0.3 * texture / texture.std(), 0, 1) * mask
-    rgb = (0.95 * (1 - density[..., None]) + np.array([0.2, 0.45, 0.85]) * density[..., None]).astype(np.float32)
+    rgb, mask = spreading_wash(size=SIZE, frames=6, seed=3, start_radius=6.0, growth=1.5)
     cache = guides.compute_guides(lambda j: mask[j], 6, params=GUIDES, cache_dir=tmp_path_factory.mktemp("source"))
     return stylize.prepare_source(rgb, cache)
 
 
 def _run(source, tmp_path, params, **options):
     folder = tmp_path / f"guides-{len(list(tmp_path.iterdir()))}"
-    return list(stylize.stylize_sequence(_moving, 5, source, params=params, guide_params=GUIDES, cache_dir=folder,
-                                         **options))
+    return list(stylize.stylize_sequence(drifting_disk, 5, source, params=params, guide_params=GUIDES,
+                                         cache_dir=folder, **options))
 
 
 @pytest.mark.parametrize("reverse", [False, True])

@@ -4,36 +4,22 @@ import dataclasses
 
 import numpy as np
 import pytest
-from scipy import ndimage
 
 from fluidymation.engine.nnf import NNF
 from fluidymation.engine.synthesis import SynthesisParams, concatenate_prepared, prepare_source
 from fluidymation.errors import StageError
 from fluidymation.stages import guides, stylize
-from tests.scenes import blob_scene, write_scene
+from tests.scenes import blob_scene, drifting_disk, spreading_wash, write_scene
 
 SIZE, EXEMPLAR_FRAMES, FRAMES, WINDOW = 32, 12, 6, 5
 GUIDES = guides.Params(blur_sigma=1.5, shape_radius=6, border_width=3, dist_time_sigma=0.5, flow_time_radius=1)
 PARAMS = stylize.Params(opt_iters=(2, 1), pm_iters=(2,), vote_only_finest=False, cuboid_radius=2, settle_passes=1)
 
 
-def _disk(radius, centre_x=SIZE / 2):
-    yy, xx = np.mgrid[:SIZE, :SIZE] + 0.5
-    return np.clip(radius - np.hypot(yy - SIZE / 2, xx - centre_x) + 0.5, 0, 1).astype(np.float32)
-
-
-def _moving(j):
-    return _disk(8.0 + 0.7 * j, centre_x=SIZE / 2 - 3 + 0.6 * j)
-
-
 @pytest.fixture(scope="module")
 def exemplar(tmp_path_factory):
     """A blotchy blue wash spreading 1 px a frame, 12 frames of 32 px: (in-memory Source, StoredSource)."""
-    rng = np.random.default_rng(5)
-    texture = ndimage.gaussian_filter(rng.standard_normal((EXEMPLAR_FRAMES, SIZE, SIZE)), (0, 1.5, 1.5))
-    mask = np.stack([_disk(4.0 + 1.0 * t) > 0.5 for t in range(EXEMPLAR_FRAMES)])
-    density = np.clip(0.55 + 0.3 * texture / texture.std(), 0, 1) * mask
-    rgb = (0.95 * (1 - density[..., None]) + np.array([0.2, 0.45, 0.85]) * density[..., None]).astype(np.float32)
+    rgb, mask = spreading_wash(size=SIZE, frames=EXEMPLAR_FRAMES, seed=5, start_radius=4.0, growth=1.0)
     folder = tmp_path_factory.mktemp("exemplar")
     cache = guides.compute_guides(lambda j: mask[j], EXEMPLAR_FRAMES, params=GUIDES, cache_dir=folder)
     stylize.store_colour(rgb, folder)
@@ -42,7 +28,7 @@ def exemplar(tmp_path_factory):
 
 def _run(source, tmp_path, params, **options):
     folder = tmp_path / f"guides-{len(list(tmp_path.iterdir()))}"
-    return list(stylize.stylize_sequence(_moving, FRAMES, source, params=params, guide_params=GUIDES,
+    return list(stylize.stylize_sequence(drifting_disk, FRAMES, source, params=params, guide_params=GUIDES,
                                          cache_dir=folder, **options))
 
 
