@@ -13,9 +13,10 @@ the n×n window of
   features (e.g. swap ext+ and ext−),
 
 plus, in the search, a per-candidate uniformity penalty looked up in a map over the
-source (:mod:`fluidymation.engine.uniformity`), times an optional per-target-pixel factor. Summation stops early once the partial
-sum exceeds the current best. A target pixel only matches source patches whose centre
-has the same segment label; pixels labelled -1 are not synthesized.
+source (:mod:`fluidymation.engine.uniformity`), times an optional per-target-pixel factor.
+Summation stops early once the partial sum exceeds the current best. A target pixel only
+matches source patches whose centre has the same segment label; pixels labelled -1 are
+not synthesized.
 
 Speed: the random search is bound by cache misses on its far candidates, so each
 pixel draws all its candidates first (boxes around the match after propagation, as

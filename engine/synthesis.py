@@ -339,6 +339,10 @@ def _downsample_maps(maps):
     return np.ascontiguousarray(np.moveaxis(downsample(np.moveaxis(maps, 0, -1)), -1, 0))
 
 
+def _downsample_map(values):
+    return _downsample_maps(values[None])[0]
+
+
 def _channel_range(values):
     """Per-channel (min, max) of (..., C) values, float64."""
     flat = values.reshape(-1, values.shape[-1])
@@ -483,7 +487,7 @@ def _synthesize(source, target, params, target_guides):
     if target_segment is None:
         target_segment = np.zeros((height, width), np.int32)
     weight_maps = _pyramid_or_none(target.weight_maps, levels, _downsample_maps)
-    uniformity_scales = _pyramid_or_none(target.uniformity_scale, levels, lambda scale: _downsample_maps(scale[None])[0])
+    uniformity_scales = _pyramid_or_none(target.uniformity_scale, levels, _downsample_map)
     target_angle = _pyramid_or_none(target.target_angle, levels, downsample_angles)
     target_segments = _pyramid_or_none(np.asarray(target_segment, np.int32), levels, downsample_labels)
     nnf = None

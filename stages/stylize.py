@@ -387,7 +387,8 @@ def stylize_sequence(
         patchmatch_iters=params.pm_iters, vote_only_finest=params.vote_only_finest,
         guided_initialization=params.guided_init, alpha=params.alpha,
         uniformity_weight=params.w_uni * params.uniformity_lambda, uniformity_radius=params.cuboid_radius,
-        histogram_matching=params.histogram_matching, orientation_weight=params.w_dir, orientation_clamp=params.dir_clamp, rotation="flow", seed=params.seed,
+        histogram_matching=params.histogram_matching, orientation_weight=params.w_dir,
+        orientation_clamp=params.dir_clamp, rotation="flow", seed=params.seed,
     )
     unit = np.float32(1.0 / params.ext_unit)
     # The exemplar's pyramid and features, once for every frame; the target's guides span
@@ -509,7 +510,8 @@ class _SlidingWindow:
         self.start, self.stop = start, stop
 
     def inside(self, nnf: NNF) -> NNF:
-        """``nnf`` (exemplar frame numbers) in window frame numbers; matches outside the window move to its nearest frame."""
+        """``nnf`` (exemplar frame numbers) in window frame numbers; matches outside the window
+        move to its nearest frame."""
         frame = np.where(nnf.frame >= 0, np.clip(nnf.frame, self.start, self.stop - 1) - self.start, -1)
         return NNF(frame.astype(np.int32), nnf.coords)
 

@@ -43,7 +43,10 @@ def drifting_disk(j: int, size: int = 32) -> np.ndarray:
 
 
 def spreading_wash(*, size: int, frames: int, seed: int, start_radius: float, growth: float):
-    """A blotchy blue wash whose disk grows ``growth`` px a frame: rgb (T, size, size, 3) float32, mask (T, size, size)."""
+    """A blotchy blue wash whose disk grows ``growth`` px a frame.
+
+    Returns rgb (T, size, size, 3) float32 and mask (T, size, size) bool.
+    """
     rng = np.random.default_rng(seed)
     texture = ndimage.gaussian_filter(rng.standard_normal((frames, size, size)), (0, 1.5, 1.5))
     mask = np.stack([disk(size, start_radius + growth * t) > 0.5 for t in range(frames)])
