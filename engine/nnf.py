@@ -316,10 +316,15 @@ def downscale_nnf(nnf, *, steps, target_shape, source_shape):
 
     Returns
     -------
-    NNF of size ``target_shape`` with integer positions.
+    NNF of size ``target_shape`` with integer positions (``steps`` = 0: a copy of ``nnf``,
+    positions untouched, so a field carried over at full resolution keeps its sub-pixel matches).
     """
     if steps < 0:
         raise ValueError(f"steps must be non-negative, got {steps}")
+    if steps == 0:
+        if nnf.shape != tuple(target_shape):
+            raise ValueError(f"steps=0 keeps the size: nnf is {nnf.shape}, target_shape {tuple(target_shape)}")
+        return NNF(nnf.frame.copy(), nnf.coords.copy())
     coarse = NNF.empty(*target_shape)
     _downscale(nnf.frame, nnf.coords, int(steps), coarse.frame, coarse.coords,
                int(source_shape[0]), int(source_shape[1]))

@@ -315,7 +315,7 @@ def _search(
     source, target, source_rows, target_rows, feature_weights, run_weights, feature_start, plain_end, group_ends,
     weight_maps, opposite_feature, source_angle, target_angle, orientation_weight, orientation_clamp, use_opposite,
     radius, target_weight_rows, swapped_rows, swapped_weight_rows,
-    source_segment, target_segment, penalty, use_penalty, penalty_scale,
+    source_segment, target_segment, penalty, use_penalty, penalty_scale, keep_margin, use_margin,
     nnf_frame, nnf_coords, error, start_frame, start_coords,
     rotation_mode, alpha, seed, salt, reverse, tile_rows,
 ):
@@ -349,6 +349,9 @@ def _search(
                 best_error = error[ty, tx]
                 scale_here = penalty_scale[ty, tx] if use_penalty else np.float32(0.0)
                 best_total = best_error + _penalty_at(penalty, use_penalty, scale_here, best_frame, best_x, best_y)
+                # a candidate replaces the match only if it is better by the pixel's relative margin
+                keep_factor = np.float32(1.0) - keep_margin[ty, tx] if use_margin else np.float32(1.0)
+                accept_below = best_total * keep_factor
                 # propagation: the neighbour's patch, shifted by the offset turned by its θ
                 for direction in range(2):
                     nx = tx - step if direction == 0 else tx
@@ -384,9 +387,9 @@ def _search(
                     if source_segment[cand_frame, int(cy + 0.5), int(cx + 0.5)] != label:
                         continue
                     cand_penalty = _penalty_at(penalty, use_penalty, scale_here, cand_frame, cx, cy)
-                    if cand_penalty >= best_total:
+                    if cand_penalty >= accept_below:
                         continue
-                    bound = best_total - cand_penalty
+                    bound = accept_below - cand_penalty
                     if _is_plain_window(plain, source_height, source_width, height, width, radius, tx, ty, cx, cy,
                                         cand_theta):
                         cand_error = _window_ssd(source_rows, target_rows, run_weights, source_height, radius,
@@ -398,13 +401,14 @@ def _search(
                             orientation_weight, orientation_clamp, use_opposite, radius, target_weight_rows,
                             swapped_rows, swapped_weight_rows, tx, ty, cand_frame, cx, cy, cand_theta, bound,
                         )
-                    if cand_error + cand_penalty < best_total:
+                    if cand_error + cand_penalty < accept_below:
                         best_frame = cand_frame
                         best_x = cx
                         best_y = cy
                         best_theta = cand_theta
                         best_error = cand_error
                         best_total = cand_error + cand_penalty
+                        accept_below = best_total * keep_factor
                 # (the plain-or-full cost dispatch is written out here and in propagation on purpose:
                 # a shared helper, even inlined, made facestyle 25-40 % slower)
                 # random search in boxes shrinking by alpha around the match after propagation (as
@@ -445,7 +449,7 @@ def _search(
                     cx = np.float32(cx_int)
                     cy = np.float32(cy_int)
                     cand_penalty = _penalty_at(penalty, use_penalty, scale_here, cand_frame, cx, cy)
-                    if cand_penalty >= best_total:
+                    if cand_penalty >= accept_below:
                         continue
                     if rotation_mode == ROTATION_FLOW:
                         # both flow-aligned angles, θ and θ + π: one sine and cosine, and (cos of the
@@ -459,7 +463,7 @@ def _search(
                         if use_opposite:
                             turn = math.cos(source_angle[cand_frame, cy_int, cx_int] + theta - target_angle[ty, tx])
                         for flip in range(2):
-                            bound = best_total - cand_penalty
+                            bound = accept_below - cand_penalty
                             cand_theta = theta if flip == 0 else np.float32(
                                 _flow_rotation(target_angle, source_angle, cand_frame, cx, cy, tx, ty, True)
                             )
@@ -470,16 +474,17 @@ def _search(
                                 cand_theta, cos_t if flip == 0 else -cos_t, sin_t if flip == 0 else -sin_t,
                                 turn < 0.0 if flip == 0 else turn > 0.0, bound,
                             )
-                            if cand_error + cand_penalty < best_total:
+                            if cand_error + cand_penalty < accept_below:
                                 best_frame = cand_frame
                                 best_x = cx
                                 best_y = cy
                                 best_theta = cand_theta
                                 best_error = cand_error
                                 best_total = cand_error + cand_penalty
+                                accept_below = best_total * keep_factor
                         continue
                     cand_theta = np.float32(0.0)
-                    bound = best_total - cand_penalty
+                    bound = accept_below - cand_penalty
                     if _is_plain_window(plain, source_height, source_width, height, width, radius, tx, ty, cx, cy,
                                         cand_theta):
                         cand_error = _window_ssd(source_rows, target_rows, run_weights, source_height, radius,
@@ -491,13 +496,14 @@ def _search(
                             orientation_weight, orientation_clamp, use_opposite, radius, target_weight_rows,
                             swapped_rows, swapped_weight_rows, tx, ty, cand_frame, cx, cy, cand_theta, bound,
                         )
-                    if cand_error + cand_penalty < best_total:
+                    if cand_error + cand_penalty < accept_below:
                         best_frame = cand_frame
                         best_x = cx
                         best_y = cy
                         best_theta = cand_theta
                         best_error = cand_error
                         best_total = cand_error + cand_penalty
+                        accept_below = best_total * keep_factor
                 nnf_frame[ty, tx] = best_frame
                 nnf_coords[ty, tx, 0] = best_x
                 nnf_coords[ty, tx, 1] = best_y
@@ -880,8 +886,8 @@ def patch_errors(cost, nnf):
     return out
 
 
-def patchmatch_pass(cost, nnf, error, *, penalty=None, penalty_scale=None, rotation_mode=0, alpha=0.75, seed=0,
-                    salt=0, reverse=False, tile_rows=TILE_ROWS):
+def patchmatch_pass(cost, nnf, error, *, penalty=None, penalty_scale=None, keep_margin=None, rotation_mode=0,
+                    alpha=0.75, seed=0, salt=0, reverse=False, tile_rows=TILE_ROWS):
     """One PatchMatch iteration (propagation, then random search), in place.
 
     Parameters
@@ -895,6 +901,9 @@ def patchmatch_pass(cost, nnf, error, *, penalty=None, penalty_scale=None, rotat
         Uniformity cost of a patch centred at each source voxel.
     penalty_scale : ndarray, shape (H, W), float32, optional
         Per target pixel factor of ``penalty`` (default 1).
+    keep_margin : ndarray, shape (H, W), float32, optional
+        Per target pixel, the relative improvement (in [0, 1)) of the cost plus penalty a
+        candidate needs to replace the current match (default 0: any improvement).
     rotation_mode : int
         ``ROTATION_NONE`` or ``ROTATION_FLOW`` (the two flow-aligned angles).
     alpha : float
@@ -913,9 +922,12 @@ def patchmatch_pass(cost, nnf, error, *, penalty=None, penalty_scale=None, rotat
         penalty = np.zeros((1, 1, 1), np.float32)
     if penalty_scale is None:
         penalty_scale = np.ones(nnf.shape if use_penalty else (1, 1), np.float32)
+    use_margin = keep_margin is not None
+    if keep_margin is None:
+        keep_margin = np.zeros((1, 1), np.float32)
     _search(
         *cost.kernel_args(), cost.source_segment, cost.target_segment, penalty, use_penalty,
-        np.ascontiguousarray(penalty_scale, np.float32),
+        np.ascontiguousarray(penalty_scale, np.float32), np.ascontiguousarray(keep_margin, np.float32), use_margin,
         nnf.frame, nnf.coords, error, nnf.frame.copy(), nnf.coords.copy(),
         int(rotation_mode), float(alpha), int(seed), int(salt), bool(reverse), int(tile_rows),
     )

@@ -180,8 +180,10 @@ class SynthesisResult:
 @dataclass(frozen=True)
 class TargetInputs:
     """The target side of :func:`synthesize_prepared` (the fields of :class:`SynthesisInputs`
-    that describe the target; ``target_guides`` in the prepared source's guide order), and
-    ``uniformity_scale`` (H, W): a per-pixel factor of the uniformity penalty (default 1)."""
+    that describe the target; ``target_guides`` in the prepared source's guide order),
+    ``uniformity_scale`` (H, W): a per-pixel factor of the uniformity penalty (default 1), and
+    ``keep_margin`` (H, W): the relative improvement in patch cost a match needs to replace the
+    one held, including ``initial_nnf``'s in the per-level merge (default 0)."""
 
     target_guides: np.ndarray
     colour_weights: np.ndarray
@@ -191,6 +193,7 @@ class TargetInputs:
     target_segment: np.ndarray | None = None
     initial_nnf: NNF | None = None
     uniformity_scale: np.ndarray | None = None
+    keep_margin: np.ndarray | None = None
 
 
 @dataclass(frozen=True)
@@ -312,7 +315,7 @@ def _check_target(target, colours, guides):
     if np.shape(target.colour_weights) != (colours,) or np.shape(target.guide_weights) != (guides,):
         raise ValueError("colour_weights and guide_weights need one weight per channel")
     shapes = {"weight_maps": (None, height, width), "target_angle": (height, width), "target_segment": (height, width),
-              "uniformity_scale": (height, width)}
+              "uniformity_scale": (height, width), "keep_margin": (height, width)}
     for name, shape in shapes.items():
         value = getattr(target, name)
         if value is not None and (value.ndim != len(shape)
@@ -488,6 +491,7 @@ def _synthesize(source, target, params, target_guides):
         target_segment = np.zeros((height, width), np.int32)
     weight_maps = _pyramid_or_none(target.weight_maps, levels, _downsample_maps)
     uniformity_scales = _pyramid_or_none(target.uniformity_scale, levels, _downsample_map)
+    keep_margins = _pyramid_or_none(target.keep_margin, levels, _downsample_map)
     target_angle = _pyramid_or_none(target.target_angle, levels, downsample_angles)
     target_segments = _pyramid_or_none(np.asarray(target_segment, np.int32), levels, downsample_labels)
     nnf = None
@@ -498,7 +502,7 @@ def _synthesize(source, target, params, target_guides):
                 source.levels[level], target, params, rank=rank, level=level, nnf=nnf,
                 optimise=not (level == 0 and levels > 1 and params.vote_only_finest), target_guides=target_guides[level],
                 weight_maps=weight_maps[level], target_angle=target_angle[level], target_segment=target_segments[level],
-                uniformity_scale=uniformity_scales[level],
+                uniformity_scale=uniformity_scales[level], keep_margin=keep_margins[level],
             )
     with threads_for(height * width):
         error = patch_errors(cost, nnf)
@@ -506,7 +510,7 @@ def _synthesize(source, target, params, target_guides):
 
 
 def _synthesize_level(prepared, target, params, *, rank, level, nnf, optimise, target_guides, weight_maps, target_angle,
-                      target_segment, uniformity_scale):
+                      target_segment, uniformity_scale, keep_margin):
     """One pyramid level: start from ``nnf`` (the coarser level's, or None), return (nnf, colour, cost)."""
     rotation_mode = _ROTATIONS[params.rotation]
     level_height, level_width = target_guides.shape[:2]
@@ -552,7 +556,10 @@ def _synthesize_level(prepared, target, params, *, rank, level, nnf, optimise, t
         if target.initial_nnf is not None:
             revote()
             other = downscaled_initial()
-            nnf, _ = merge_nnf(nnf, other, patch_errors(cost, nnf), patch_errors(cost, other))
+            held_error = patch_errors(cost, other)
+            if keep_margin is not None:
+                held_error = held_error * np.where(np.isfinite(held_error), 1.0 - keep_margin, 1.0).astype(np.float32)
+            nnf, _ = merge_nnf(nnf, other, patch_errors(cost, nnf), held_error)
     colour = revote()
 
     if random_start and params.guided_initialization:
@@ -580,7 +587,7 @@ def _synthesize_level(prepared, target, params, *, rank, level, nnf, optimise, t
                                             patch_size=params.patch_size, frame_radius=params.uniformity_radius)
                 penalty = uniformity_penalty(occurrence, source_segment=cost.source_segment, scales=scales,
                                              patch_size=params.patch_size)
-            patchmatch_pass(cost, nnf, error, penalty=penalty, penalty_scale=uniformity_scale,
+            patchmatch_pass(cost, nnf, error, penalty=penalty, penalty_scale=uniformity_scale, keep_margin=keep_margin,
                             rotation_mode=rotation_mode, alpha=params.alpha,
                             seed=params.seed, salt=_salt(level, 3, em, iteration), reverse=iteration % 2 == 1,
                             tile_rows=params.tile_rows)

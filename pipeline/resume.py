@@ -1,7 +1,7 @@
 """What an interrupted stylize stage needs to continue: the state after its last finished frame.
 
-After each frame's files are written, the frame's state (its NNF and the motion not yet
-followed, see :class:`fluidymation.stages.stylize.StylizedFrame`) is saved atomically as
+After each frame's files are written, the frame's state (its NNF, the motion not yet
+followed and its colour, see :class:`fluidymation.stages.stylize.StylizedFrame`) is saved atomically as
 ``<index>.npz`` and older states are removed. A restarted run continues after the longest
 prefix of the processing order whose frames are all finished and whose last state is
 saved; :func:`~fluidymation.stages.stylize.stylize_sequence` then yields exactly the
@@ -32,7 +32,8 @@ class FrameStates:
     def save(self, frame: StylizedFrame) -> None:
         """Save ``frame``'s state (after its files), then drop the states before it."""
         with atomic_path(self._path(frame.index)) as tmp, open(tmp, "wb") as handle:
-            np.savez(handle, frame=frame.nnf.frame, coords=frame.nnf.coords, backlog=frame.backlog)
+            np.savez(handle, frame=frame.nnf.frame, coords=frame.nnf.coords, backlog=frame.backlog,
+                     rgb=frame.rgba[..., :3])
         for older in self.folder.glob("*.npz"):
             if older != self._path(frame.index):
                 older.unlink(missing_ok=True)
@@ -51,5 +52,5 @@ class FrameStates:
             index = order[count - 1]
             if index in saved:
                 with np.load(self._path(index)) as state:
-                    return count, (index, NNF(state["frame"], state["coords"]), state["backlog"])
+                    return count, (index, NNF(state["frame"], state["coords"]), state["backlog"], state["rgb"])
         return None

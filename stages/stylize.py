@@ -31,6 +31,7 @@ from pathlib import Path
 from typing import Callable, Iterator, NamedTuple
 
 import numpy as np
+from scipy import ndimage
 
 from fluidymation.engine import distance
 from fluidymation.engine.nnf import NNF
@@ -43,7 +44,7 @@ from fluidymation.errors import StageError
 from fluidymation.stages import guides
 
 NAME = "stylize"
-VERSION = 1
+VERSION = 2
 
 #: Target guide channels, in order; the source compares shape, ext+, ext− and its colour (as S_temp).
 _GUIDES = ("shape", "ext_plus", "ext_minus", "temp_r", "temp_g", "temp_b")
@@ -98,6 +99,13 @@ class Params:
         Times a fresh start (the first frame processed) is synthesized again with itself
         as the previous frame, so the next frames do not re-trade its unconverged matches
         (beyond the paper; docs/stylize.md).
+    keep_margin : float
+        Where the temporal term holds (m(q) = 1), the relative improvement in patch cost a
+        match needs to replace the one carried over from the previous frame (scaled by
+        m(q); 0: the paper). Settle passes do not use it (beyond the paper; docs/stylize.md).
+    still_speed : float
+        Motion (px, since the previous frame and not yet followed) under which the target
+        counts as still: there, carried-over matches are kept outright (0: never).
     source_window : int or None
         Exemplar frames held and searched at a time (None: all). The window slides evenly
         from the exemplar's first frames at the first processing step to its last frames
@@ -128,6 +136,8 @@ class Params:
     pyramid_levels: int | None = None
     reverse: bool = False
     settle_passes: int = 3
+    keep_margin: float = 0.2
+    still_speed: float = 0.05
     source_window: int | None = None
     seed: int = 0
 
@@ -152,6 +162,8 @@ class Params:
             ("pm_iters", bool(self.pm_iters) and min(self.pm_iters) >= 0, "a list of counts ≥ 0"),
             ("pyramid_levels", self.pyramid_levels is None or self.pyramid_levels >= 1, "≥ 1"),
             ("settle_passes", self.settle_passes >= 0, "≥ 0"),
+            ("keep_margin", 0 <= self.keep_margin <= 1, "between 0 and 1"),
+            ("still_speed", self.still_speed >= 0, "≥ 0"),
             ("source_window", self.source_window is None or (
                 isinstance(self.source_window, (int, np.integer)) and not isinstance(self.source_window, bool)
                 and self.source_window >= self.min_source_window),
@@ -353,9 +365,9 @@ def stylize_sequence(
     frames : (first, stop), optional
         Only synthesize sequence frames first..stop−1 (the first one processed starts
         afresh). Default: all.
-    resume : (index, nnf, backlog), optional
+    resume : (index, nnf, backlog, rgb), optional
         Continue after the already processed frame ``index`` (one of ``frames``) from its
-        :class:`StylizedFrame` ``nnf`` and ``backlog``; the frames yielded are then exactly
+        :class:`StylizedFrame` ``nnf``, ``backlog`` and colour ``rgba[..., :3]``; the frames yielded are then exactly
         those an uninterrupted run yields after ``index``.
 
     Yields
@@ -371,8 +383,9 @@ def stylize_sequence(
     target = guides.compute_guides(lambda k: masks(order[k]), frame_count, params=guide_params, cache_dir=cache_dir)
     steps = [k for k in range(frame_count) if first <= order[k] < stop]
     previous = None  # (NNF, inside mask, ext+, motion not yet followed) of the frame processed before
+    previous_rgb = None  # and its colour
     if resume is not None:
-        done, resume_nnf, resume_backlog = resume
+        done, resume_nnf, resume_backlog, previous_rgb = resume
         done_steps = [k for k in steps if order[k] == done]
         if not done_steps:
             raise StageError(f"stylize: cannot resume after frame {done}, which is not among frames {first}:{stop}")
@@ -425,14 +438,16 @@ def stylize_sequence(
         segment = np.where(inside, np.maximum(frame.segments.astype(np.int32) - 1, 0), -1).astype(np.int32)
         temp = np.zeros((target.height, target.width, 3), np.float32)
         modulation = np.zeros((1, target.height, target.width), np.float32)
-        initial = None
+        initial = keep_margin = None
         backlog = np.zeros((target.height, target.width), np.float32)
         if previous is not None:
             previous_nnf, previous_inside, previous_ext_plus, previous_backlog = previous
             # Motion smaller than one source frame's would be lost frame after frame: carry it over.
             wanted = frame.ext_plus - previous_ext_plus + np.where(previous_inside, previous_backlog, 0.0)
+            # still paint stays in its exemplar frame; its motion waits in the backlog until it counts
+            followed = np.where(np.abs(wanted) < params.still_speed, np.float32(0.0), wanted).astype(np.float32)
             initial, achieved = shift_nnf(
-                held.inside(previous_nnf), target_motion=wanted, target_angle=frame.direction,
+                held.inside(previous_nnf), target_motion=followed, target_angle=frame.direction,
                 source_ext_plus=exemplar.ext_plus, source_ext_minus=exemplar.ext_minus, source_angle=exemplar.angle,
             )
             backlog = np.where(initial.frame >= 0, wanted - achieved, 0.0).astype(np.float32)
@@ -442,6 +457,8 @@ def stylize_sequence(
                     initial, target_dist=border_clamped(frame.dist, target.border_width), source_dist=exemplar.dist,
                     previous_mask=previous_inside, lower=params.m_lower * d, upper=params.m_upper * d,
                 )
+                if settle_pass == 0:  # a fresh start's settle passes converge freely
+                    keep_margin = carried_margin(modulation[0], wanted, previous_inside, params)
         target_guides = np.concatenate([
             frame.shape[..., None], frame.ext_plus[..., None] * unit, frame.ext_minus[..., None] * unit, temp,
         ], axis=2)
@@ -451,6 +468,7 @@ def stylize_sequence(
                 target_guides=target_guides, colour_weights=np.ones(3, np.float32), guide_weights=guide_weights,
                 weight_maps=modulation, target_angle=frame.direction, target_segment=segment, initial_nnf=initial,
                 uniformity_scale=1.0 - (1.0 - np.float32(params.uni_carried)) * modulation[0],
+                keep_margin=keep_margin,
             ),
             dataclasses.replace(synthesis, seed=int(counter_hash(params.seed, k, settle_pass) % np.uint64(2**31))),
         )
@@ -469,9 +487,33 @@ def stylize_sequence(
             for settle_pass in range(1, params.settle_passes + 1):
                 result, backlog = synthesize_frame(k, frame, inside, (result.nnf, inside, frame.ext_plus, backlog),
                                                    settle_pass)
-        rgba = np.concatenate([np.clip(result.image, 0.0, 1.0), coverage[..., None]], axis=2)
-        previous = (result.nnf, inside, frame.ext_plus, backlog)
+        rgb = np.clip(result.image, 0.0, 1.0)
+        if previous is not None:
+            rgb = np.where(_unchanged_paint(result.nnf, previous[0], params.patch_size)[..., None], previous_rgb, rgb)
+        rgba = np.concatenate([rgb, coverage[..., None]], axis=2)
+        previous, previous_rgb = (result.nnf, inside, frame.ext_plus, backlog), rgb
         yield StylizedFrame(index=index, rgba=rgba, nnf=result.nnf, mean_error=result.mean_error(), backlog=backlog)
+
+
+def _unchanged_paint(nnf: NNF, previous: NNF, patch_size: int) -> np.ndarray:
+    """Pixels whose every covering patch is the previous frame's match, unshifted: their vote is the previous one."""
+    same = (nnf.frame == previous.frame) & ((nnf.frame < 0) | np.all(nnf.coords == previous.coords, axis=2))
+    covered = ndimage.minimum_filter(same.astype(np.uint8), size=patch_size, mode="constant", cval=1).astype(bool)
+    return covered & (nnf.frame >= 0)
+
+
+def carried_margin(modulation: np.ndarray, motion: np.ndarray, carried: np.ndarray, params: Params) -> np.ndarray:
+    """Per target pixel, the relative improvement a match needs to replace the one carried over.
+
+    ``modulation`` is m(q), ``motion`` the target's motion amount (px) to be followed in
+    this step and ``carried`` where the previous frame had paint. Where the temporal term
+    holds, a carried-over match is only traded for one ``keep_margin`` better (times m(q));
+    where the target is still (``motion`` under ``still_speed``) it is kept outright,
+    whatever m(q): paint that does not move does not change (beyond the paper;
+    docs/stylize.md, "Stationary regions").
+    """
+    still = carried & (np.abs(motion) < params.still_speed)
+    return np.where(still, np.float32(1.0), np.float32(params.keep_margin) * modulation).astype(np.float32)
 
 
 #: Relative margin of the fixed quantization ranges of a sliding source window.

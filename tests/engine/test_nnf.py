@@ -53,6 +53,19 @@ def test_downscale_inverts_upscale(rotate):
         np.testing.assert_array_equal(back.coords, coarse.coords)
 
 
+def test_downscale_by_no_steps_keeps_sub_pixel_matches():
+    # the previous frame's field is carried over at full resolution: rounding it there
+    # re-traded about half of a still target's matches every frame
+    field = random_field(np.random.default_rng(4), (5, 6), (3, 40, 40), rotate=True)
+    field.coords[..., :2] += np.float32(0.37)
+    same = downscale_nnf(field, steps=0, target_shape=(5, 6), source_shape=(40, 40))
+    np.testing.assert_array_equal(same.frame, field.frame)
+    np.testing.assert_array_equal(same.coords, field.coords)
+    assert same.coords is not field.coords
+    with pytest.raises(ValueError, match="keeps the size"):
+        downscale_nnf(field, steps=0, target_shape=(4, 6), source_shape=(40, 40))
+
+
 def test_downscale_takes_the_mode_and_skips_unmatched():
     fine = NNF.empty(2, 4)
     fine.frame[:] = [[0, 1, -1, -1], [0, 0, -1, -1]]

@@ -140,6 +140,39 @@ def test_penalty_scaled_per_target_pixel():
     np.testing.assert_allclose(error[0], exact[0], rtol=1e-4)
 
 
+def test_keep_margin_refuses_small_improvements():
+    rng = np.random.default_rng(9)
+    cost, source, target, _ = make_cost(rng, frames=2, source=(6, 6), target=(4, 5))
+    start = NNF.empty(4, 5)
+    fill_random(start, target_segment=cost.target_segment, source_segment=cost.source_segment, seed=3)
+
+    def search(margin, passes=40):
+        field = NNF(start.frame.copy(), start.coords.copy())
+        error = patch_errors(cost, field)
+        for iteration in range(passes):
+            patchmatch_pass(cost, field, error, keep_margin=margin, alpha=0.5, seed=3, salt=iteration,
+                            reverse=iteration % 2 == 1, tile_rows=2)
+        return field, error
+
+    free, free_error = search(None)
+    zero, zero_error = search(np.zeros((4, 5), np.float32))
+    np.testing.assert_array_equal(zero.coords, free.coords)
+    np.testing.assert_array_equal(zero_error, free_error)
+    # margin 1 on row 0: nothing there is ever good enough; the other rows search as before
+    margin = np.zeros((4, 5), np.float32)
+    margin[0] = 1.0
+    held, held_error = search(margin)
+    np.testing.assert_array_equal(held.frame[0], start.frame[0])
+    np.testing.assert_array_equal(held.coords[0], start.coords[0])
+    assert held_error[1:].mean() < patch_errors(cost, start)[1:].mean()
+    # margin 0.5: every accepted change at least halved the cost of the match it replaced
+    half, half_error = search(np.full((4, 5), 0.5, np.float32), passes=1)
+    initial = patch_errors(cost, start)
+    changed = (half.frame != start.frame) | np.any(half.coords != start.coords, axis=2)
+    assert changed.any()
+    assert np.all(half_error[changed] < 0.5 * initial[changed])
+
+
 def test_matches_stay_in_their_segment():
     rng = np.random.default_rng(10)
     source_segment = np.zeros((2, 9, 10), np.int32)

@@ -63,7 +63,8 @@ def test_a_killed_render_resumes_without_redoing_frames_and_matches_an_uninterru
 
 def _state(index, value):
     nnf = NNF(np.full((2, 2), index, np.int32), np.full((2, 2, 3), value, np.float32))
-    return StylizedFrame(index=index, rgba=None, nnf=nnf, mean_error=0.0, backlog=np.full((2, 2), value, np.float32))
+    rgba = np.full((2, 2, 4), value, np.float32)
+    return StylizedFrame(index=index, rgba=rgba, nnf=nnf, mean_error=0.0, backlog=np.full((2, 2), value, np.float32))
 
 
 def test_the_resume_point_is_the_longest_finished_prefix_with_a_saved_state(tmp_path):
@@ -72,8 +73,9 @@ def test_the_resume_point_is_the_longest_finished_prefix_with_a_saved_state(tmp_
     states.save(_state(4, 0.25))  # processing in reverse: 5 then 4; 5's state is dropped
     assert sorted(path.name for path in tmp_path.iterdir()) == ["00004.npz"]
     order = [5, 4, 3, 2]
-    count, (index, nnf, backlog) = states.resume_point(order, lambda frame: frame in (5, 4, 2))
+    count, (index, nnf, backlog, rgb) = states.resume_point(order, lambda frame: frame in (5, 4, 2))
     assert (count, index) == (2, 4) and nnf.frame[0, 0] == 4 and backlog[0, 0] == np.float32(0.25)
+    assert rgb.shape == (2, 2, 3) and rgb[0, 0, 0] == np.float32(0.25)
     assert states.resume_point(order, lambda frame: frame == 5) is None  # frame 4's files are missing
 
 

@@ -35,7 +35,8 @@ def test_resuming_from_a_frames_state_gives_the_remaining_frames_bit_for_bit(sou
     whole = _run(source, tmp_path, params)
     done = whole[1]
     saved = NNF(done.nnf.frame.copy(), done.nnf.coords.copy())  # as the pipeline stores and reloads it
-    rest = _run(source, tmp_path, params, resume=(done.index, saved, done.backlog.copy()))
+    rest = _run(source, tmp_path, params, resume=(done.index, saved, done.backlog.copy(),
+                                                  done.rgba[..., :3].copy()))
     assert [f.index for f in rest] == [f.index for f in whole[2:]]
     assert np.abs(done.backlog).max() > 0  # the carried motion matters here
     for resumed, uninterrupted in zip(rest, whole[2:]):
@@ -45,4 +46,5 @@ def test_resuming_from_a_frames_state_gives_the_remaining_frames_bit_for_bit(sou
 
 def test_resuming_after_a_frame_outside_the_window_is_refused(source, tmp_path):
     with pytest.raises(StageError, match="cannot resume after frame 4"):
-        _run(source, tmp_path, PARAMS, frames=(1, 3), resume=(4, NNF.empty(SIZE, SIZE), np.zeros((SIZE, SIZE))))
+        _run(source, tmp_path, PARAMS, frames=(1, 3), resume=(4, NNF.empty(SIZE, SIZE), np.zeros((SIZE, SIZE)),
+                                                                np.zeros((SIZE, SIZE, 3))))

@@ -83,7 +83,8 @@ def test_resuming_a_windowed_run_gives_the_remaining_frames_bit_for_bit(exemplar
     done = whole[2]
     saved = NNF(done.nnf.frame.copy(), done.nnf.coords.copy())
     # the resumed run prepares its first window afresh; the uninterrupted one slid into it
-    _same(_run(stored, tmp_path, params, resume=(done.index, saved, done.backlog.copy())), whole[3:])
+    resume = (done.index, saved, done.backlog.copy(), done.rgba[..., :3].copy())
+    _same(_run(stored, tmp_path, params, resume=resume), whole[3:])
 
 
 def test_frames_prepared_apart_and_joined_equal_the_window_prepared_at_once(exemplar):
