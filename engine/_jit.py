@@ -11,10 +11,37 @@ in parallel must write disjoint slices so results do not depend on the thread co
 import contextlib
 
 import numba
+from llvmlite import binding as llvm
 from llvmlite import ir
 from numba import types
-from numba.core import cgutils
+from numba.core import cgutils, codegen
 from numba.extending import intrinsic
+
+
+def _optimize_with_own_copies(library, _optimize=codegen.CPUCodeLibrary._optimize_final_module):
+    """Bind each library's calls to its own copies of the kernels it links in.
+
+    Numba links a copy of every called kernel (and of every ``prange`` body) into the
+    caller's module as a weak (``linkonce_odr``, ``weak_odr``) definition and optimizes it again there; the
+    JIT then binds a call to whichever definition of the name it loaded first: the callee's
+    own code after a fresh compilation, the caller's copy when the caller comes from the disk
+    cache. With fastmath's ``reassoc`` the two may round differently, so results differed in
+    the last bits between a fresh and a cached process. Made internal, the copies are always
+    the code that runs, the same code as the cached object.
+    """
+    linked = {
+        function.name
+        for linked_library in library._linking_libraries
+        for function in linked_library._get_module_for_linking().functions
+        if not function.is_declaration
+    }
+    for function in library._final_module.functions:
+        if function.name in linked and not function.is_declaration:
+            function.linkage = llvm.Linkage.internal
+    _optimize(library)
+
+
+codegen.CPUCodeLibrary._optimize_final_module = _optimize_with_own_copies
 
 kernel = numba.njit(cache=True, fastmath=True, nogil=True)
 parallel_kernel = numba.njit(cache=True, fastmath=True, nogil=True, parallel=True)
