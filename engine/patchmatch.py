@@ -315,7 +315,7 @@ def _search(
     source, target, source_rows, target_rows, feature_weights, run_weights, feature_start, plain_end, group_ends,
     weight_maps, opposite_feature, source_angle, target_angle, orientation_weight, orientation_clamp, use_opposite,
     radius, target_weight_rows, swapped_rows, swapped_weight_rows,
-    source_segment, target_segment, penalty, use_penalty, penalty_scale, keep_margin, use_margin,
+    source_segment, target_segment, penalty, use_penalty, penalty_scale, keep_margin,
     nnf_frame, nnf_coords, error, start_frame, start_coords,
     rotation_mode, alpha, seed, salt, reverse, tile_rows,
 ):
@@ -350,7 +350,7 @@ def _search(
                 scale_here = penalty_scale[ty, tx] if use_penalty else np.float32(0.0)
                 best_total = best_error + _penalty_at(penalty, use_penalty, scale_here, best_frame, best_x, best_y)
                 # a candidate replaces the match only if it is better by the pixel's relative margin
-                keep_factor = np.float32(1.0) - keep_margin[ty, tx] if use_margin else np.float32(1.0)
+                keep_factor = np.float32(1.0) - keep_margin[ty, tx]
                 accept_below = best_total * keep_factor
                 # propagation: the neighbour's patch, shifted by the offset turned by its θ
                 for direction in range(2):
@@ -922,12 +922,11 @@ def patchmatch_pass(cost, nnf, error, *, penalty=None, penalty_scale=None, keep_
         penalty = np.zeros((1, 1, 1), np.float32)
     if penalty_scale is None:
         penalty_scale = np.ones(nnf.shape if use_penalty else (1, 1), np.float32)
-    use_margin = keep_margin is not None
     if keep_margin is None:
-        keep_margin = np.zeros((1, 1), np.float32)
+        keep_margin = np.zeros(nnf.shape, np.float32)
     _search(
         *cost.kernel_args(), cost.source_segment, cost.target_segment, penalty, use_penalty,
-        np.ascontiguousarray(penalty_scale, np.float32), np.ascontiguousarray(keep_margin, np.float32), use_margin,
+        np.ascontiguousarray(penalty_scale, np.float32), np.ascontiguousarray(keep_margin, np.float32),
         nnf.frame, nnf.coords, error, nnf.frame.copy(), nnf.coords.copy(),
         int(rotation_mode), float(alpha), int(seed), int(salt), bool(reverse), int(tile_rows),
     )

@@ -102,14 +102,21 @@ def test_texture_is_not_washed_out(source, tmp_path):
         assert _local_contrast(frame.rgba, moving(frame.index) > 0.5) >= 0.8 * exemplar_contrast
 
 
+def still_part(j):
+    return _disk(11, radius=8.0)
+
+
+def moving_part(j):
+    return _disk(32 + j, radius=9.0)
+
+
+def still_and_moving(j):
+    """One layer of two disks: one stays where it is, one moves 1 px/frame along +x."""
+    return np.maximum(still_part(j), moving_part(j))
+
+
 def test_moving_regions_change_more_than_stationary_ones(source, tmp_path):
-    def still_part(j):
-        return _disk(11, radius=8.0)
-
-    def moving_part(j):
-        return _disk(32 + j, radius=9.0)
-
-    frames = _run(lambda j: np.maximum(still_part(j), moving_part(j)), 5, source, tmp_path)
+    frames = _run(still_and_moving, 5, source, tmp_path)
     still = ndimage.binary_erosion(still_part(0) > 0.5, iterations=2)
     for a, b in zip(frames, frames[1:]):
         moved = ndimage.binary_erosion((moving_part(a.index) > 0.5) & (moving_part(b.index) > 0.5), iterations=2)
@@ -145,16 +152,9 @@ def test_still_regions_change_no_more_than_the_exemplars_stationary_regions(tmp_
     cache = guides.compute_guides(lambda j: ex.mask[j], len(ex.rgb), params=GUIDES, cache_dir=tmp_path / "source",
                                   given_flow=lambda j: ex.flow[j])
     dry = stylize.prepare_source(ex.rgb, cache)
-
-    def still_part(j):
-        return _disk(11, radius=8.0)
-
-    def moving_part(j):
-        return _disk(32 + j, radius=9.0)
-
     # one layer: the moving disk changes which exemplar frames the layer draws from (and so
     # its histogram matching) frame after frame; the still disk must not follow
-    frames = _run(lambda j: np.maximum(still_part(j), moving_part(j)), 6, dry, tmp_path)
+    frames = _run(still_and_moving, 6, dry, tmp_path)
     still = ndimage.binary_erosion(still_part(0) > 0.5, iterations=2)
     moved = ndimage.binary_erosion(moving_part(2) > 0.5, iterations=2)
     change = [np.abs(a.rgba - b.rgba)[..., :3] for a, b in zip(frames, frames[1:])]
