@@ -8,7 +8,7 @@ a flow estimated from the masks (``flow: masks``, the default) or from the frame
 parameters is used. Generated built-in exemplars and all exemplar guides are kept under
 :func:`fluidymation.pipeline.paths.cache_dir`; an exemplar's colour is stored beside its
 guides, so a stage reads from disk only the exemplar frames it needs
-(:class:`fluidymation.stages.stylize.StoredSource`) and a cached exemplar is not loaded whole.
+(:class:`fluidymation.stages.exemplar_store.StoredSource`) and a cached exemplar is not loaded whole.
 """
 
 from __future__ import annotations
@@ -25,7 +25,7 @@ from fluidymation.errors import SceneError, StageError
 from fluidymation.pipeline import paths
 from fluidymation.pipeline.presets import resolve_params
 from fluidymation.pipeline.resolve import Plan, PlannedLayer
-from fluidymation.stages import exemplar_builtin, exemplar_user, guides, stylize
+from fluidymation.stages import exemplar_builtin, exemplar_store, exemplar_user, guides
 
 DEFAULT_BUILTIN = "watercolor-bloom"
 _BUILTIN_OPTIONS = ("kind", "builtin", "seed", "size", "frames", "color", "wetness")
@@ -94,7 +94,7 @@ def exemplar_identity(plan: Plan, layer: PlannedLayer) -> str:
 
 
 def layer_source(plan: Plan, layer: PlannedLayer, guide_params: guides.Params, *,
-                 progress=None) -> stylize.StoredSource:
+                 progress=None) -> exemplar_store.StoredSource:
     """The layer's exemplar and its guides on disk, generated on first use and cached.
 
     ``progress`` is called with no arguments after each simulated exemplar frame.
@@ -102,7 +102,7 @@ def layer_source(plan: Plan, layer: PlannedLayer, guide_params: guides.Params, *
     name, spec = exemplar_spec(plan, layer)
     identity = exemplar_identity(plan, layer)
     record = json.dumps({"exemplar": identity, "guides": dataclasses.asdict(guide_params), "version": guides.VERSION,
-                         "colour": stylize.StoredSource.COLOUR_FILE}, sort_keys=True)
+                         "colour": exemplar_store.StoredSource.COLOUR_FILE}, sort_keys=True)
     entry = paths.exemplar_guides_cache_dir() / f"{identity}-{hashlib.sha256(record.encode()).hexdigest()[:12]}"
     if not (entry / "done").is_file():
         if spec["kind"] == "builtin":
@@ -114,7 +114,7 @@ def layer_source(plan: Plan, layer: PlannedLayer, guide_params: guides.Params, *
             rgb, masks = recording.rgb, recording.mask
             flow = exemplar_user.motion_flow(rgb, seed=spec.get("seed", 0)) if spec.get("flow") == "motion" else None
         _store_with_guides(entry, record, rgb, masks, flow, guide_params)
-    return stylize.StoredSource(entry)
+    return exemplar_store.StoredSource(entry)
 
 
 def _recording_identity(params: exemplar_user.Params, spec: dict) -> str:
@@ -133,7 +133,7 @@ def _store_with_guides(entry: Path, record: str, rgb, masks, flow, guide_params:
     try:
         guides.compute_guides(lambda j: masks[j], len(masks), params=guide_params, cache_dir=staging,
                               given_flow=None if flow is None else (lambda j: flow[j]))
-        stylize.store_colour(rgb, staging)
+        exemplar_store.store_colour(rgb, staging)
         with open(f"{staging}/done", "w") as handle:
             handle.write(record)
         try:

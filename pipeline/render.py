@@ -38,7 +38,7 @@ from fluidymation.pipeline.parameters import (
 from fluidymation.pipeline.progress import progress, reporter
 from fluidymation.pipeline.resolve import Plan, PlannedLayer
 from fluidymation.pipeline.resume import FrameStates
-from fluidymation.stages import background, colorize, composite, encode, rasterize, stylize
+from fluidymation.stages import background, colorize, composite, encode, exemplar_store, rasterize, stylize
 from fluidymation.stages.colour import parse_hex
 from fluidymation.stages.files import read_image, write_npy, write_png, write_text
 from fluidymation.stages.guide_views import write_guide_views
@@ -222,7 +222,7 @@ class _Run:
                                 frames=self._frame_span(), nnf=options.nnf)
         sources = []
 
-        def source() -> stylize.StoredSource:  # opened only when a stage has to run
+        def source() -> exemplar_store.StoredSource:  # opened only when a stage has to run
             if not sources:
                 sources.append(load_layer_source(plan, layer, guide_params, options.quiet))
             return sources[0]
@@ -385,7 +385,7 @@ def read_coverage(coverage_dir: Path, index: int) -> np.ndarray:
     return read_image(coverage_dir / f"{index:05d}.png", channels=1)[:, :, 0]
 
 
-def load_layer_source(plan: Plan, layer: PlannedLayer, guide_params, quiet=False) -> stylize.StoredSource:
+def load_layer_source(plan: Plan, layer: PlannedLayer, guide_params, quiet=False) -> exemplar_store.StoredSource:
     """The layer's exemplar with its guides on disk (generated on first use), with a progress bar."""
     with progress(simulated_frame_count(plan, layer), "exemplar", layer=layer.name, quiet=quiet) as bar:
         return layer_source(plan, layer, guide_params, progress=bar.update)
@@ -396,7 +396,7 @@ def stylized_files(out_dir: Path, index: int, *, nnf=False) -> list[Path]:
     return [out_dir / f"{index:05d}.png"] + ([out_dir / "nnf" / f"{index:05d}.npy"] if nnf else [])
 
 
-def stylize_layer(plan: Plan, layer: PlannedLayer, window: range, source: stylize.StoredSource, params: stylize.Params,
+def stylize_layer(plan: Plan, layer: PlannedLayer, window: range, source: exemplar_store.StoredSource, params: stylize.Params,
                   guide_params, *, coverage_dir: Path, out_dir: Path, quiet=False, nnf=False,
                   states: FrameStates | None = None, resume: tuple[int, tuple] | None = None) -> list[Path]:
     """Stylize a layer's window of scene frames (coverage read from ``coverage_dir``) into ``out_dir``.
@@ -434,7 +434,7 @@ def layer_colorize_params(layer: PlannedLayer, fill_color: str | None) -> colori
     return colorize.Params(mode="layer", color=tuple(float(c) for c in parse_hex(hex_color)))
 
 
-def colorize_layer(plan: Plan, layer: PlannedLayer, window: range, source: stylize.StoredSource,
+def colorize_layer(plan: Plan, layer: PlannedLayer, window: range, source: exemplar_store.StoredSource,
                    params: colorize.Params, out: Path, *, quiet=False) -> list[Path]:
     """Colorize the layer's stylized frames into ``out/layers/<layer>/``; return the files written.
 

@@ -86,9 +86,9 @@ def exemplar_source(width, height, frames, guide_params, folder, *, stored=False
     cache = guides.compute_guides(lambda j: exemplar.mask[j], frames, params=guide_params, cache_dir=folder,
                                   given_flow=lambda j: exemplar.flow[j])
     if not stored:
-        return stylize.prepare_source(exemplar.rgb, cache)
-    stylize.store_colour(exemplar.rgb, folder)
-    return stylize.StoredSource(folder)
+        return exemplar_store.in_memory(exemplar.rgb, cache)
+    exemplar_store.store_colour(exemplar.rgb, folder)
+    return exemplar_store.StoredSource(folder)
 
 
 def target_masks(shape, width, height):
@@ -120,7 +120,7 @@ def run_case(name, profile, window=None, stored=None):
         if stored is None:
             source = exemplar_source(ex_width, ex_height, ex_frames, guide_params, folder / "source")
         else:
-            source = stylize.StoredSource(stored)
+            source = exemplar_store.StoredSource(stored)
         packed = [np.packbits(masks(j)) for j in range(frame_count)]
         masked = [int(masks(j).sum()) for j in range(frame_count)]
 

@@ -29,7 +29,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 from stages import test_stylize as scene  # noqa: E402
 
 from fluidymation.engine.shiftnnf import shift_nnf  # noqa: E402
-from fluidymation.stages import guides, stylize  # noqa: E402
+from fluidymation.stages import exemplar_store, guides, stylize  # noqa: E402
 
 
 def _texture_shift(a, b, region):
@@ -112,7 +112,7 @@ def main():
     with tempfile.TemporaryDirectory() as workdir:
         cache = guides.compute_guides(lambda j: mask[j], len(mask), params=scene.GUIDES,
                                       cache_dir=Path(workdir) / "source", given_flow=lambda j: flow[j])
-        source = stylize.prepare_source(rgb, cache)
+        source = exemplar_store.in_memory(rgb, cache)
         measure_moving(source, args.frames, args.speed, workdir, params)
         if args.still_frames > 1:
             measure_still(source, args.still_frames, workdir, params)

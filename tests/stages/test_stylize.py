@@ -8,7 +8,7 @@ import pytest
 from scipy import ndimage
 
 from fluidymation.errors import StageError
-from fluidymation.stages import exemplar_builtin, guides, stylize
+from fluidymation.stages import exemplar_builtin, exemplar_store, guides, stylize
 
 SIZE = 48
 GUIDES = guides.Params(blur_sigma=1.5, shape_radius=6, border_width=3, dist_time_sigma=0.5, flow_time_radius=1)
@@ -46,7 +46,7 @@ def source(tmp_path_factory):
     rgb, mask, flow = _stain()
     cache = guides.compute_guides(lambda j: mask[j], len(mask), params=GUIDES,
                                   cache_dir=tmp_path_factory.mktemp("source"), given_flow=lambda j: flow[j])
-    return stylize.prepare_source(rgb, cache)
+    return exemplar_store.in_memory(rgb, cache)
 
 
 def _disk(centre_x, radius=13.0, centre_y=SIZE / 2):
@@ -151,7 +151,7 @@ def test_still_regions_change_no_more_than_the_exemplars_stationary_regions(tmp_
                                       for t, still in enumerate(stationary, 1)]).mean()
     cache = guides.compute_guides(lambda j: ex.mask[j], len(ex.rgb), params=GUIDES, cache_dir=tmp_path / "source",
                                   given_flow=lambda j: ex.flow[j])
-    dry = stylize.prepare_source(ex.rgb, cache)
+    dry = exemplar_store.in_memory(ex.rgb, cache)
     # one layer: the moving disk changes which exemplar frames the layer draws from (and so
     # its histogram matching) frame after frame; the still disk must not follow
     frames = _run(still_and_moving, 6, dry, tmp_path)

@@ -7,7 +7,7 @@ import pytest
 
 from fluidymation.engine.nnf import NNF
 from fluidymation.errors import StageError
-from fluidymation.stages import guides, stylize
+from fluidymation.stages import exemplar_store, guides, stylize
 from tests.scenes import drifting_disk, spreading_wash
 
 SIZE = 32
@@ -20,7 +20,7 @@ def source(tmp_path_factory):
     """A blotchy blue wash spreading 1.5 px a frame, 6 frames of 32 px."""
     rgb, mask = spreading_wash(size=SIZE, frames=6, seed=3, start_radius=6.0, growth=1.5)
     cache = guides.compute_guides(lambda j: mask[j], 6, params=GUIDES, cache_dir=tmp_path_factory.mktemp("source"))
-    return stylize.prepare_source(rgb, cache)
+    return exemplar_store.in_memory(rgb, cache)
 
 
 def _run(source, tmp_path, params, **options):

@@ -8,7 +8,7 @@ import pytest
 from fluidymation.engine.nnf import NNF
 from fluidymation.engine.synthesis import SynthesisParams, concatenate_prepared, prepare_source
 from fluidymation.errors import StageError
-from fluidymation.stages import guides, stylize
+from fluidymation.stages import exemplar_store, guides, stylize
 from tests.scenes import blob_scene, drifting_disk, spreading_wash, write_scene
 
 SIZE, EXEMPLAR_FRAMES, FRAMES, WINDOW = 32, 12, 6, 5
@@ -22,8 +22,8 @@ def exemplar(tmp_path_factory):
     rgb, mask = spreading_wash(size=SIZE, frames=EXEMPLAR_FRAMES, seed=5, start_radius=4.0, growth=1.0)
     folder = tmp_path_factory.mktemp("exemplar")
     cache = guides.compute_guides(lambda j: mask[j], EXEMPLAR_FRAMES, params=GUIDES, cache_dir=folder)
-    stylize.store_colour(rgb, folder)
-    return stylize.prepare_source(rgb, cache), stylize.StoredSource(folder)
+    exemplar_store.store_colour(rgb, folder)
+    return exemplar_store.in_memory(rgb, cache), exemplar_store.StoredSource(folder)
 
 
 def _run(source, tmp_path, params, **options):
