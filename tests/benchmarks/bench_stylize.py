@@ -79,7 +79,7 @@ def exemplar_source(width, height, frames, guide_params, folder, *, stored=False
     with ``stored`` as a StoredSource in ``folder``."""
     from fluidymation.pipeline import paths
     from fluidymation.pipeline.presets import resolve_params
-    from fluidymation.stages import exemplar_builtin, guides, stylize
+    from fluidymation.stages import exemplar_builtin, exemplar_store, guides
 
     params = resolve_params("watercolor-bloom", size=(width, height), frames=frames)
     exemplar = exemplar_builtin.make_builtin_exemplar(params, cache_dir=paths.exemplar_cache_dir())
@@ -101,7 +101,7 @@ def run_case(name, profile, window=None, stored=None):
     """Child process: run one case (with ``source_window`` ``window``; the exemplar stored in ``stored``,
     or generated here), print one JSON line with its figures."""
     from fluidymation.pipeline.parameters import stylize_defaults
-    from fluidymation.stages import guides, stylize
+    from fluidymation.stages import exemplar_store, guides, stylize
 
     (width, height), frame_count, (ex_width, ex_height, ex_frames), shape = CASES[name]
     params = stylize.Params(**stylize_defaults() | {"source_window": window})
