@@ -26,6 +26,7 @@ are processed, so memory does not grow with the exemplar's length either.
 from __future__ import annotations
 
 import dataclasses
+import functools
 from dataclasses import dataclass
 from typing import Callable, Iterator, NamedTuple
 
@@ -258,117 +259,218 @@ def stylize_sequence(
     order = list(range(frame_count - 1, -1, -1)) if params.reverse else list(range(frame_count))
     target = guides.compute_guides(lambda k: masks(order[k]), frame_count, params=guide_params, cache_dir=cache_dir)
     steps = [k for k in range(frame_count) if first <= order[k] < stop]
-    previous = None  # (NNF, inside mask, ext+, motion not yet followed) of the frame processed before
-    previous_rgb = None  # and its colour
+    previous = None
     if resume is not None:
-        done, resume_nnf, resume_backlog, previous_rgb = resume
-        done_steps = [k for k in steps if order[k] == done]
-        if not done_steps:
+        done = resume[0]
+        done_step = next((k for k in steps if order[k] == done), None)
+        if done_step is None:
             raise StageError(f"stylize: cannot resume after frame {done}, which is not among frames {first}:{stop}")
-        done_frame = target.frame(done_steps[0])
-        done_coverage = _coverage(masks(done), (target.height, target.width), done)
-        previous = (resume_nnf, _inside(done_frame, done_coverage), done_frame.ext_plus,
-                    np.asarray(resume_backlog, np.float32))
-        steps = steps[steps.index(done_steps[0]) + 1:]
-    d = max(target.height, target.width)
-    synthesis = SynthesisParams(
-        patch_size=params.patch_size, pyramid_levels=params.pyramid_levels, search_vote_iters=params.opt_iters,
-        patchmatch_iters=params.pm_iters, vote_only_finest=params.vote_only_finest,
-        guided_initialization=params.guided_init, alpha=params.alpha,
-        uniformity_weight=params.w_uni * params.uniformity_lambda, uniformity_radius=params.cuboid_radius,
-        histogram_matching=params.histogram_matching, orientation_weight=params.w_dir,
-        orientation_clamp=params.dir_clamp, rotation="flow", seed=params.seed,
-    )
-    unit = np.float32(1.0 / params.ext_unit)
-    # The exemplar's pyramid and features, once for every frame; the target's guides span
-    # shape [0, 1], ext± up to the sequence's largest and a temporal guide of exemplar colours (0 where unvoted).
-    ext_max = max(target.meta["ext_plus_max"], target.meta["ext_minus_max"]) * unit
-    window = source.frame_count if params.source_window is None else min(params.source_window, source.frame_count)
-    colour_range, guide_range = None, ([0.0] * 6, [1.0, ext_max, ext_max, 1.0, 1.0, 1.0])
-    if window < source.frame_count:
-        # A sliding window prepares a few frames at a time: quantize every frame over the same
-        # ranges, covering the whole exemplar (colour in [0, 1]) with a margin for the pyramid's rounding.
-        low, high = -_RANGE_MARGIN, 1.0 + _RANGE_MARGIN
-        ext_max = max(ext_max, source.ext_max * float(unit)) * high
-        colour_range, guide_range = ([low] * 3, [high] * 3), ([low] * 6, [high, ext_max, ext_max, high, high, high])
-
-    def prepare(frames: Source):
-        return prepare_engine_source(
-            frames.rgb, np.concatenate([
-                frames.shape[..., None], frames.ext_plus[..., None] * unit, frames.ext_minus[..., None] * unit,
-                frames.rgb,
-            ], axis=3),
-            guide_weight_map=_WEIGHT_MAP, opposite_guide=_OPPOSITE, source_angle=frames.angle,
-            source_segment=frames.segment, guide_range=guide_range, colour_range=colour_range, params=synthesis,
-        )
-
-    held = _SlidingWindow(source, prepare)
-    guide_weights = np.array([params.w_bound, params.w_ext, params.w_ext] + [params.w_temp] * 3, np.float32)
-
-    def synthesize_frame(k, frame, inside, previous, settle_pass):
-        """Synthesize processing step k from ``previous`` (None: afresh) in the held window; return (result, backlog).
-
-        NNFs come and go in exemplar frame numbers; inside, they count from the window's start.
-        """
-        exemplar = held.frames
-        segment = np.where(inside, np.maximum(frame.segments.astype(np.int32) - 1, 0), -1).astype(np.int32)
-        temp = np.zeros((target.height, target.width, 3), np.float32)
-        modulation = np.zeros((1, target.height, target.width), np.float32)
-        initial = keep_margin = None
-        backlog = np.zeros((target.height, target.width), np.float32)
-        if previous is not None:
-            previous_nnf, previous_inside, previous_ext_plus, previous_backlog = previous
-            # Motion smaller than one source frame's would be lost frame after frame: carry it over.
-            wanted = frame.ext_plus - previous_ext_plus + np.where(previous_inside, previous_backlog, 0.0)
-            # still paint stays in its exemplar frame; its motion waits in the backlog until it counts
-            followed = np.where(np.abs(wanted) < params.still_speed, np.float32(0.0), wanted).astype(np.float32)
-            initial, achieved = shift_nnf(
-                held.inside(previous_nnf), target_motion=followed, target_angle=frame.direction,
-                source_ext_plus=exemplar.ext_plus, source_ext_minus=exemplar.ext_minus, source_angle=exemplar.angle,
-            )
-            backlog = np.where(initial.frame >= 0, wanted - achieved, 0.0).astype(np.float32)
-            if params.w_temp > 0:
-                temp, _ = vote(exemplar.rgb, initial, patch_size=params.patch_size)
-                modulation[0] = temporal_modulation(
-                    initial, target_dist=border_clamped(frame.dist, target.border_width), source_dist=exemplar.dist,
-                    previous_mask=previous_inside, lower=params.m_lower * d, upper=params.m_upper * d,
-                )
-                if settle_pass == 0:  # a fresh start's settle passes converge freely
-                    keep_margin = carried_margin(modulation[0], wanted, previous_inside, params)
-        target_guides = np.concatenate([
-            frame.shape[..., None], frame.ext_plus[..., None] * unit, frame.ext_minus[..., None] * unit, temp,
-        ], axis=2)
-        result = synthesize_prepared(
-            held.prepared,
-            TargetInputs(
-                target_guides=target_guides, colour_weights=np.ones(3, np.float32), guide_weights=guide_weights,
-                weight_maps=modulation, target_angle=frame.direction, target_segment=segment, initial_nnf=initial,
-                uniformity_scale=1.0 - (1.0 - np.float32(params.uni_carried)) * modulation[0],
-                keep_margin=keep_margin,
-            ),
-            dataclasses.replace(synthesis, seed=int(counter_hash(params.seed, k, settle_pass) % np.uint64(2**31))),
-        )
-        return dataclasses.replace(result, nnf=held.outside(result.nnf)), backlog
-
+        previous = _resumed(resume, target.frame(done_step), masks(done), (target.height, target.width))
+        steps = steps[steps.index(done_step) + 1:]
+    sequence = _Sequence.set_up(target, source, params)
     for k in steps:
-        index = order[k]
-        start = window_start(k, frame_count, source.frame_count, window)
-        held.move(start, start + window)
-        frame = target.frame(k)
-        coverage = _coverage(masks(index), (target.height, target.width), index)
-        inside = _inside(frame, coverage)
-        result, backlog = synthesize_frame(k, frame, inside, previous, 0)
-        if previous is None:
-            # settle a fresh start: resynthesize it with itself as the previous frame (no motion)
-            for settle_pass in range(1, params.settle_passes + 1):
-                result, backlog = synthesize_frame(k, frame, inside, (result.nnf, inside, frame.ext_plus, backlog),
-                                                   settle_pass)
+        stylized, previous = _stylize_step(sequence, k, order[k], masks(order[k]), previous)
+        yield stylized
+
+
+class _Previous(NamedTuple):
+    """The frame processed before, as the next step continues from it."""
+
+    nnf: NNF  #: its matches, in exemplar frame numbers
+    inside: np.ndarray  #: (H, W) bool, where the layer covers it
+    ext_plus: np.ndarray  #: (H, W) float32, its ext+ guide: the motion since is measured from it
+    backlog: np.ndarray  #: (H, W) float32, the motion it has not yet followed
+    rgb: np.ndarray | None  #: (H, W, 3) its colour, kept where its paint is unchanged (None while it settles)
+
+
+def _resumed(resume: tuple, frame: guides.FrameGuides, mask, shape: tuple[int, int]) -> _Previous:
+    """The state after the already processed frame of ``resume`` = (index, nnf, backlog, rgb); ``frame`` and
+    ``mask`` are its guides and coverage."""
+    index, nnf, backlog, rgb = resume
+    inside = _inside(frame, _coverage(mask, shape, index))
+    return _Previous(nnf, inside, frame.ext_plus, np.asarray(backlog, np.float32), rgb)
+
+
+@dataclass(frozen=True)
+class _Sequence:
+    """What every processing step of one sequence reads and none changes (the window's frames slide).
+
+    Attributes
+    ----------
+    params : Params
+    target : guides.GuideCache
+        The target guides, in processing order.
+    synthesis : SynthesisParams
+        The engine's parameters; each pass reseeds them.
+    unit : np.float32
+        ``1 / ext_unit``: ext+ and ext− are compared in this unit.
+    guide_weights : np.ndarray
+        (6,) float32, the weights of the guide channels (``_GUIDES``).
+    d : int
+        The larger target side; the temporal modulation's bounds are fractions of it.
+    window : _SlidingWindow
+        The exemplar frames held and searched.
+    """
+
+    params: Params
+    target: guides.GuideCache
+    synthesis: SynthesisParams
+    unit: np.float32
+    guide_weights: np.ndarray
+    d: int
+    window: _SlidingWindow
+
+    @classmethod
+    def set_up(cls, target: guides.GuideCache, source: Source | StoredSource, params: Params) -> _Sequence:
+        """The fixed inputs of stylizing ``target`` (its guides) from ``source`` with ``params``.
+
+        No exemplar frame is read yet: the window fills at the first step.
+        """
+        synthesis = SynthesisParams(
+            patch_size=params.patch_size, pyramid_levels=params.pyramid_levels, search_vote_iters=params.opt_iters,
+            patchmatch_iters=params.pm_iters, vote_only_finest=params.vote_only_finest,
+            guided_initialization=params.guided_init, alpha=params.alpha,
+            uniformity_weight=params.w_uni * params.uniformity_lambda, uniformity_radius=params.cuboid_radius,
+            histogram_matching=params.histogram_matching, orientation_weight=params.w_dir,
+            orientation_clamp=params.dir_clamp, rotation="flow", seed=params.seed,
+        )
+        unit = np.float32(1.0 / params.ext_unit)
+        length = source.frame_count if params.source_window is None else min(params.source_window, source.frame_count)
+        guide_range, colour_range = _quantization_ranges(target, source, unit, sliding=length < source.frame_count)
+        prepare = functools.partial(_prepare_exemplar, unit=unit, guide_range=guide_range, colour_range=colour_range,
+                                    synthesis=synthesis)
+        return cls(
+            params=params, target=target, synthesis=synthesis, unit=unit,
+            guide_weights=np.array([params.w_bound, params.w_ext, params.w_ext] + [params.w_temp] * 3, np.float32),
+            d=max(target.height, target.width), window=_SlidingWindow(source, length, target.frame_count, prepare),
+        )
+
+
+#: Relative margin of the fixed quantization ranges of a sliding source window.
+_RANGE_MARGIN = 1e-3
+
+
+def _quantization_ranges(target: guides.GuideCache, source: Source | StoredSource, unit: np.float32, *,
+                         sliding: bool) -> tuple:
+    """(guide_range, colour_range) the exemplar's features are quantized over.
+
+    The target's guides span shape [0, 1], ext± up to the sequence's largest and a temporal
+    guide of exemplar colours (0 where unvoted); the exemplar's own colour range is measured
+    (None). A sliding window prepares a few frames at a time: then every frame is quantized
+    over the same ranges, covering the whole exemplar (colour in [0, 1]) with a margin for
+    the pyramid's rounding.
+    """
+    ext_max = max(target.meta["ext_plus_max"], target.meta["ext_minus_max"]) * unit
+    if not sliding:
+        return ([0.0] * 6, [1.0, ext_max, ext_max, 1.0, 1.0, 1.0]), None
+    low, high = -_RANGE_MARGIN, 1.0 + _RANGE_MARGIN
+    ext_max = max(ext_max, source.ext_max * float(unit)) * high
+    return ([low] * 6, [high, ext_max, ext_max, high, high, high]), ([low] * 3, [high] * 3)
+
+
+def _prepare_exemplar(frames: Source, *, unit: np.float32, guide_range, colour_range, synthesis: SynthesisParams):
+    """The engine's prepared source (pyramid, features) of exemplar ``frames``.
+
+    Its guides pair with the target's (``_GUIDES``): shape, ext± in ``unit``, and its colour,
+    which the temporal guide is compared with.
+    """
+    return prepare_engine_source(
+        frames.rgb, np.concatenate([
+            frames.shape[..., None], frames.ext_plus[..., None] * unit, frames.ext_minus[..., None] * unit,
+            frames.rgb,
+        ], axis=3),
+        guide_weight_map=_WEIGHT_MAP, opposite_guide=_OPPOSITE, source_angle=frames.angle,
+        source_segment=frames.segment, guide_range=guide_range, colour_range=colour_range, params=synthesis,
+    )
+
+
+def _stylize_step(sequence: _Sequence, k: int, index: int, mask, previous: _Previous | None,
+                  ) -> tuple[StylizedFrame, _Previous]:
+    """Processing step ``k``: sequence frame ``index`` with coverage ``mask``, continued from ``previous``
+    (None: a fresh start, settled); return the frame and the state the next step continues from.
+
+    Where its paint is the previous frame's, unshifted, the previous colour stays.
+    """
+    sequence.window.slide_to(k)
+    target = sequence.target
+    frame = target.frame(k)
+    coverage = _coverage(mask, (target.height, target.width), index)
+    inside = _inside(frame, coverage)
+    if previous is None:
+        result, backlog = _fresh_start(sequence, k, frame, inside)
         rgb = np.clip(result.image, 0.0, 1.0)
-        if previous is not None:
-            rgb = np.where(_unchanged_paint(result.nnf, previous[0], params.patch_size)[..., None], previous_rgb, rgb)
-        rgba = np.concatenate([rgb, coverage[..., None]], axis=2)
-        previous, previous_rgb = (result.nnf, inside, frame.ext_plus, backlog), rgb
-        yield StylizedFrame(index=index, rgba=rgba, nnf=result.nnf, mean_error=result.mean_error(), backlog=backlog)
+    else:
+        result, backlog = _synthesize(sequence, k, frame, inside, previous, settle_pass=0)
+        unchanged = _unchanged_paint(result.nnf, previous.nnf, sequence.params.patch_size)
+        rgb = np.where(unchanged[..., None], previous.rgb, np.clip(result.image, 0.0, 1.0))
+    rgba = np.concatenate([rgb, coverage[..., None]], axis=2)
+    stylized = StylizedFrame(index=index, rgba=rgba, nnf=result.nnf, mean_error=result.mean_error(), backlog=backlog)
+    return stylized, _Previous(result.nnf, inside, frame.ext_plus, backlog, rgb)
+
+
+def _fresh_start(sequence: _Sequence, k: int, frame: guides.FrameGuides, inside: np.ndarray):
+    """Synthesize step ``k`` with no previous frame, then settle it: ``settle_passes`` times
+    again with itself as the previous frame (no motion), so the next frames do not re-trade
+    its unconverged matches. Return (result, backlog)."""
+    result, backlog = _synthesize(sequence, k, frame, inside, None, settle_pass=0)
+    for settle_pass in range(1, sequence.params.settle_passes + 1):
+        itself = _Previous(result.nnf, inside, frame.ext_plus, backlog, rgb=None)
+        result, backlog = _synthesize(sequence, k, frame, inside, itself, settle_pass=settle_pass)
+    return result, backlog
+
+
+def _synthesize(sequence: _Sequence, k: int, frame: guides.FrameGuides, inside: np.ndarray,
+                previous: _Previous | None, *, settle_pass: int):
+    """One synthesis pass of step ``k`` in the held window; return (result, backlog).
+
+    Without ``previous`` it starts from a random field. With it, it starts from SHIFTNNF of
+    the previous matches along the target's motion (plus the previous backlog; motion under
+    ``still_speed`` waits in the backlog), its temporal guide is the exemplar voted through
+    that field, weighted by m(q), and (outside settle passes) carried-over matches are kept
+    unless ``keep_margin`` better (:func:`carried_margin`). Every (step, pass) has its own
+    seed. NNFs come and go in exemplar frame numbers; inside, they count from the window's start.
+    """
+    params, target, held = sequence.params, sequence.target, sequence.window
+    exemplar = held.frames
+    segment = np.where(inside, np.maximum(frame.segments.astype(np.int32) - 1, 0), -1).astype(np.int32)
+    temp = np.zeros((target.height, target.width, 3), np.float32)
+    modulation = np.zeros((1, target.height, target.width), np.float32)
+    initial = keep_margin = None
+    backlog = np.zeros((target.height, target.width), np.float32)
+    if previous is not None:
+        # Motion smaller than one source frame's would be lost frame after frame: carry it over.
+        wanted = frame.ext_plus - previous.ext_plus + np.where(previous.inside, previous.backlog, 0.0)
+        # still paint stays in its exemplar frame; its motion waits in the backlog until it counts
+        followed = np.where(np.abs(wanted) < params.still_speed, np.float32(0.0), wanted).astype(np.float32)
+        initial, achieved = shift_nnf(
+            held.inside(previous.nnf), target_motion=followed, target_angle=frame.direction,
+            source_ext_plus=exemplar.ext_plus, source_ext_minus=exemplar.ext_minus, source_angle=exemplar.angle,
+        )
+        backlog = np.where(initial.frame >= 0, wanted - achieved, 0.0).astype(np.float32)
+        if params.w_temp > 0:
+            temp, _ = vote(exemplar.rgb, initial, patch_size=params.patch_size)
+            modulation[0] = temporal_modulation(
+                initial, target_dist=border_clamped(frame.dist, target.border_width), source_dist=exemplar.dist,
+                previous_mask=previous.inside, lower=params.m_lower * sequence.d, upper=params.m_upper * sequence.d,
+            )
+            if settle_pass == 0:  # a fresh start's settle passes converge freely
+                keep_margin = carried_margin(modulation[0], wanted, previous.inside, params)
+    unit = sequence.unit
+    target_guides = np.concatenate([
+        frame.shape[..., None], frame.ext_plus[..., None] * unit, frame.ext_minus[..., None] * unit, temp,
+    ], axis=2)
+    result = synthesize_prepared(
+        held.prepared,
+        TargetInputs(
+            target_guides=target_guides, colour_weights=np.ones(3, np.float32), guide_weights=sequence.guide_weights,
+            weight_maps=modulation, target_angle=frame.direction, target_segment=segment, initial_nnf=initial,
+            uniformity_scale=1.0 - (1.0 - np.float32(params.uni_carried)) * modulation[0],
+            keep_margin=keep_margin,
+        ),
+        dataclasses.replace(sequence.synthesis,
+                            seed=int(counter_hash(params.seed, k, settle_pass) % np.uint64(2**31))),
+    )
+    return dataclasses.replace(result, nnf=held.outside(result.nnf)), backlog
 
 
 def _unchanged_paint(nnf: NNF, previous: NNF, patch_size: int) -> np.ndarray:
@@ -392,22 +494,24 @@ def carried_margin(modulation: np.ndarray, motion: np.ndarray, carried: np.ndarr
     return np.where(still, np.float32(1.0), np.float32(params.keep_margin) * modulation).astype(np.float32)
 
 
-#: Relative margin of the fixed quantization ranges of a sliding source window.
-_RANGE_MARGIN = 1e-3
-
-
 class _SlidingWindow:
-    """The exemplar frames ``start..stop−1`` held at a time: a :class:`Source` and the engine's prepared source.
+    """The ``length`` exemplar frames held at a time: a :class:`Source` and the engine's prepared source.
 
-    Moving keeps the frames the old and new windows share and reads and prepares only
+    At each of the ``step_count`` processing steps it holds the frames from :func:`window_start`.
+    Sliding keeps the frames the old and new windows share and reads and prepares only
     the frames gained (the pyramid and quantization act on each frame alone).
     """
 
-    def __init__(self, source, prepare: Callable):
-        self.source, self.prepare = source, prepare
+    def __init__(self, source, length: int, step_count: int, prepare: Callable):
+        self.source, self.length, self.step_count, self.prepare = source, length, step_count, prepare
         self.start = self.stop = 0
         self.frames: Source | None = None
         self.prepared = None
+
+    def slide_to(self, step: int) -> None:
+        """Hold the window of processing step ``step``."""
+        start = window_start(step, self.step_count, self.source.frame_count, self.length)
+        self.move(start, start + self.length)
 
     def move(self, start: int, stop: int) -> None:
         if (start, stop) == (self.start, self.stop):
