@@ -76,7 +76,7 @@ def layer_guide_params(plan: Plan, layer: PlannedLayer) -> guides.Params:
     check_layer_params(plan, layer)
     chosen = {key: value for key, value in layer.spec.params.items() if key in GUIDE_NAMES}
     try:
-        return guides.Params(**chosen, scale=plan.size[0] / plan.source.width)
+        return guides.Params(**chosen, scale=plan.size[0] / plan.document.width)
     except (TypeError, ValueError, StageError) as exc:
         raise SceneError(f"{plan.scene.path}: layer '{layer.name}' params: {exc}") from None
 

@@ -325,8 +325,7 @@ class _Run:
 
 def input_digest(plan: Plan) -> list[str]:
     """Content hashes of the scene's vector input (every file of a numbered sequence)."""
-    files = getattr(plan.source, "files", None) or [plan.scene.input]
-    return [file_digest(path) for path in files]
+    return [file_digest(path) for path in plan.document.files]
 
 
 def rasterize_layer(plan: Plan, layer: PlannedLayer, frames: range, masks_dir: Path, *,
@@ -341,7 +340,7 @@ def rasterize_layer(plan: Plan, layer: PlannedLayer, frames: range, masks_dir: P
     tally, areas = rasterize.ColorTally(), []
     for frame in frames:
         name = f"{frame - plan.start:05d}.png"
-        image = rasterize.rasterize_frame(plan.source, layer.vector_layers, frame, raster)
+        image = rasterize.rasterize_frame(plan.renderer, plan.document, layer.vector_layers, frame, raster)
         write_png(masks_dir / name, image.mask.astype(np.uint8) * 255)
         if coverage_dir is not None:
             write_png(coverage_dir / name, image.coverage)

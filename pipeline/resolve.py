@@ -1,4 +1,4 @@
-"""From a validated scene to a concrete plan: the opened input, fps, frames, size, layers.
+"""From a validated scene to a concrete plan: the opened input and its renderer, fps, frames, size, layers.
 
 Scene frame numbers count from time 0 of the input at the scene's fps; the plan's range
 is ``start``..``end`` (exclusive), and output files are numbered from ``start``.
@@ -12,7 +12,7 @@ from dataclasses import dataclass, replace
 
 from fluidymation.errors import SceneError
 from fluidymation.pipeline.scene import MAX_FRAMES, MAX_SIZE, LayerSpec, Scene
-from fluidymation.stages.vector import DEFAULT_FPS, VectorSource, open_vector
+from fluidymation.stages.vector import DEFAULT_FPS, Renderer, VectorDocument, open_document, renderer_for
 
 
 @dataclass(frozen=True)
@@ -36,7 +36,8 @@ class PlannedLayer:
 @dataclass(frozen=True)
 class Plan:
     scene: Scene
-    source: VectorSource
+    document: VectorDocument
+    renderer: Renderer
     fps: float
     start: int
     end: int
@@ -67,10 +68,10 @@ class Plan:
 
 
 def plan_scene(scene: Scene) -> Plan:
-    """Open the scene's input and work out frames, size and each layer's selection."""
-    source = open_vector(scene.input, split=scene.split)
-    fps = scene.fps or source.native_fps or DEFAULT_FPS
-    default_start, default_end = source.default_range(fps)
+    """Open the scene's input, choose its renderer and work out frames, size and each layer's selection."""
+    document = open_document(scene.input, split=scene.split, fps=scene.fps)
+    fps = scene.fps or document.native_fps or DEFAULT_FPS
+    default_start, default_end = document.frame_range(fps)
     start = scene.frames.start if scene.frames else default_start
     end = scene.frames.end if scene.frames and scene.frames.end is not None else default_end
     if end <= start:
@@ -78,10 +79,11 @@ def plan_scene(scene: Scene) -> Plan:
                          f"{default_start}:{default_end} at {fps:g} fps)")
     if end - start > MAX_FRAMES:
         raise SceneError(f"{scene.path}: {end - start} frames is over the limit of {MAX_FRAMES}")
-    if source.kind == "svg-sequence" and end > default_end:
+    if document.kind == "svg-sequence" and end > default_end:
         raise SceneError(f"{scene.path}: frames.end {end} is past the end of the sequence "
                          f"({default_end} files)")
-    return Plan(scene, source, fps, start, end, _size(scene, source), _layers(scene, source))
+    return Plan(scene, document, renderer_for(document), fps, start, end, _size(scene, document),
+                _layers(scene, document))
 
 
 def parse_window(text: str | None) -> tuple[int | None, int | None] | None:
@@ -101,21 +103,21 @@ def _fmt(window) -> str:
     return ":".join("" if part is None else str(part) for part in window)
 
 
-def _size(scene: Scene, source: VectorSource) -> tuple[int, int]:
+def _size(scene: Scene, document: VectorDocument) -> tuple[int, int]:
     if scene.size:
         return scene.size
     scale = scene.scale or 1.0
-    width, height = (max(1, round(extent * scale)) for extent in (source.width, source.height))
+    width, height = (max(1, round(extent * scale)) for extent in (document.width, document.height))
     if width > MAX_SIZE or height > MAX_SIZE:
         raise SceneError(f"{scene.path}: the output would be {width}x{height} px, over the limit of "
                          f"{MAX_SIZE} px a side; set size or a smaller scale")
     return width, height
 
 
-def _layers(scene: Scene, source: VectorSource) -> tuple[PlannedLayer, ...]:
-    z_of = {layer.name: layer.z for layer in source.layers}
+def _layers(scene: Scene, document: VectorDocument) -> tuple[PlannedLayer, ...]:
+    z_of = {layer.name: layer.z for layer in document.layers}
     if scene.layers is None:
-        specs = [_default_layer(scene, name) for name in dict.fromkeys(source.layer_names())]
+        specs = [_default_layer(scene, name) for name in dict.fromkeys(document.layer_names())]
         return tuple(PlannedLayer(spec, (spec.name,), z_of[spec.name]) for spec in specs)
     planned = []
     for index, spec in enumerate(scene.layers):

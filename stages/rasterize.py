@@ -1,8 +1,8 @@
 """rasterize stage: each scene layer alone, per frame, as anti-aliased coverage and a mask.
 
-Coverage is the alpha of the selected vector layers rendered together (cairosvg), in
-[0, 1]; the binary mask is coverage >= 0.5. The layer's fill colour is the most common
-colour of its fully covered pixels over the frames rendered.
+Coverage is the alpha of the selected vector layers drawn together by the input's
+renderer, in [0, 1]; the binary mask is coverage >= 0.5. The layer's fill colour is the
+most common colour of its fully covered pixels over the frames rendered.
 """
 
 from __future__ import annotations
@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from fluidymation.stages.vector import VectorSource
+from fluidymation.stages.vector import Renderer, VectorDocument
 
 NAME = "rasterize"
 VERSION = 1
@@ -37,9 +37,10 @@ class LayerRaster:
         return self.coverage >= MASK_THRESHOLD
 
 
-def rasterize_frame(source: VectorSource, vector_layers: tuple[str, ...], frame: int, params: Params) -> LayerRaster:
-    """Render ``vector_layers`` of ``source`` alone at scene ``frame``."""
-    rgba = source.render(list(vector_layers), frame, params.fps, params.size)
+def rasterize_frame(renderer: Renderer, document: VectorDocument, vector_layers: tuple[str, ...], frame: int,
+                    params: Params) -> LayerRaster:
+    """Render ``vector_layers`` of ``document`` alone at scene ``frame`` (time ``frame / fps``)."""
+    rgba = renderer.render(document, vector_layers, frame / params.fps, params.size)
     return LayerRaster(rgba[:, :, 3].astype(np.float32) / np.float32(255.0), rgba)
 
 

@@ -9,9 +9,10 @@ from fluidymation.stages.rasterize import ColorTally, Params, rasterize_frame
 
 def add_parser(subparsers) -> None:
     parser = subparsers.add_parser("check", help="validate a scene file and print the resolved scene",
-                                   description="Validate SCENE and print its input, size, fps, frame range "
-                                               "and, per scene layer, the vector layers it selects, their "
-                                               "fill colour and z-order.")
+                                   description="Validate SCENE and print its input (with the reader and "
+                                               "renderer it uses), size, fps, frame range and, per scene "
+                                               "layer, the vector layers it selects, their fill colour and "
+                                               "z-order.")
     parser.add_argument("scene", help="the scene's YAML file")
     parser.set_defaults(run=run)
 
@@ -23,16 +24,17 @@ def run(args) -> int:
 
 
 def describe(plan: Plan) -> str:
-    scene, source = plan.scene, plan.source
-    native_fps = f"{source.native_fps:g} fps" if source.native_fps else "no frame rate"
+    scene, document, renderer = plan.scene, plan.document, plan.renderer
+    native_fps = f"{document.native_fps:g} fps" if document.native_fps else "no frame rate"
     lines = [
         f"scene:   {scene.path}",
-        f"input:   {scene.input} ({source.kind}, {source.width:g}x{source.height:g} px, {native_fps})",
+        f"input:   {scene.input} ({document.kind}, {document.width:g}x{document.height:g} px, {native_fps})",
+        f"reader:  {document.reader} v{document.reader_version}, renderer {renderer.name} v{renderer.version}",
         f"size:    {plan.size[0]}x{plan.size[1]} px",
         f"fps:     {plan.fps:g}",
         f"frames:  {plan.start}:{plan.end} ({plan.frame_count} frames)",
         f"output:  {scene.output.dir}",
-        f"vector layers (bottom to top): {', '.join(source.layer_names()) or '(none)'}",
+        f"vector layers (bottom to top): {', '.join(document.layer_names()) or '(none)'}",
         "scene layers (bottom to top):",
     ]
     params = Params(size=plan.size, fps=plan.fps)
@@ -40,7 +42,7 @@ def describe(plan: Plan) -> str:
     for layer in sorted(plan.layers, key=lambda layer: layer.z):
         tally = ColorTally()
         for frame in samples:
-            tally.add(rasterize_frame(source, layer.vector_layers, frame, params).rgba)
+            tally.add(rasterize_frame(renderer, document, layer.vector_layers, frame, params).rgba)
         found = tally.dominant() or "none (never visible in the sampled frames)"
         color = f"{layer.spec.color} (set in the scene; file: {found})" if layer.spec.color else found
         lines.append(f"  {layer.name}: z={layer.z}, selects {', '.join(layer.vector_layers)}, colour {color}")

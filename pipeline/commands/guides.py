@@ -10,7 +10,7 @@ from fluidymation.pipeline.resolve import parse_window, plan_scene
 from fluidymation.pipeline.scene import load_scene
 from fluidymation.stages.rasterize import Params as RasterParams
 from fluidymation.stages.rasterize import rasterize_frame
-from fluidymation.stages.vector.svg_input import sequence_files
+from fluidymation.stages.vector.svg_reader import sequence_files
 
 
 def add_parser(subparsers) -> None:
@@ -39,7 +39,8 @@ def run(args) -> int:
     given = given_flows(args.flow, plan.frame_count) if args.flow else None
 
     def coverage(index: int):
-        return rasterize_frame(plan.source, layer.vector_layers, plan.start + index, raster).coverage
+        image = rasterize_frame(plan.renderer, plan.document, layer.vector_layers, plan.start + index, raster)
+        return image.coverage
 
     write_layer_guides(plan, layer, window, coverage, out_dir, quiet=args.quiet, raw=args.raw, given_flow=given)
     if not args.quiet:

@@ -1,7 +1,9 @@
-"""Readers for vector animations: Lottie (.json/.lottie/.tgs), SVG (static, SMIL, sequences).
+"""Vector animations: the reader table (files to documents) and the renderer table (documents to pixels).
 
-:func:`open_vector` picks the reader from the path and returns a
-:class:`~fluidymation.stages.vector.base.VectorSource`.
+:func:`open_document` opens a Lottie (.json/.lottie/.tgs) or SVG (static, SMIL, numbered
+sequence) input with the first reader of :data:`READERS` that takes its path;
+:func:`renderer_for` picks the first renderer of :data:`RENDERERS` that draws the
+document's kind.
 """
 
 from __future__ import annotations
@@ -9,35 +11,39 @@ from __future__ import annotations
 from pathlib import Path
 
 from fluidymation.errors import InputError
-from fluidymation.stages.files import is_sequence_pattern
-from fluidymation.stages.vector.base import DEFAULT_FPS, VectorLayer, VectorSource
-from fluidymation.stages.vector.lottie_input import open_lottie, open_smil_svg
-from fluidymation.stages.vector.svg_input import (
-    SvgSequenceSource,
-    SvgSource,
-    has_smil,
-    load_svg,
-    sequence_files,
+from fluidymation.stages.vector import lottie_reader, smil_reader, svg_reader
+from fluidymation.stages.vector.base import DEFAULT_FPS, Reader, Renderer, VectorDocument, VectorLayer
+from fluidymation.stages.vector.cairosvg_renderer import CairoSvgRenderer
+from fluidymation.stages.vector.lottie_svg_renderer import LottieSvgRenderer
+
+__all__ = ["DEFAULT_FPS", "READERS", "RENDERERS", "Reader", "Renderer", "VectorDocument", "VectorLayer",
+           "open_document", "renderer_for"]
+
+READERS: tuple[Reader, ...] = (
+    svg_reader.SEQUENCE_READER,
+    lottie_reader.READER,
+    smil_reader.READER,
+    svg_reader.SVG_READER,
 )
-
-__all__ = ["DEFAULT_FPS", "VectorLayer", "VectorSource", "open_vector"]
-
-_LOTTIE_SUFFIXES = (".json", ".lottie", ".tgs")
+RENDERERS: tuple[Renderer, ...] = (LottieSvgRenderer(), CairoSvgRenderer())
 
 
-def open_vector(path: Path, *, split: tuple[str, ...] = ()) -> VectorSource:
+def open_document(path: Path, *, split: tuple[str, ...] = (), fps: float | None = None) -> VectorDocument:
     """Open the vector animation at ``path`` (a file, or a pattern of numbered SVG files).
 
-    ``split`` lists precomp layer names (or globs) to be split into their children.
+    ``split`` lists precomp layer names (or globs) to be split into their children; ``fps``
+    is the scene's frame rate, if it sets one (a numbered sequence shows a file per frame).
     """
-    text = str(path)
-    suffix = path.suffix.lower()
-    if suffix == ".svg" and is_sequence_pattern(path.name):
-        return SvgSequenceSource(text, sequence_files(path))
-    if suffix in _LOTTIE_SUFFIXES:
-        return open_lottie(path, split=split)
-    if suffix == ".svg":
-        root = load_svg(path)
-        return open_smil_svg(path, root) if has_smil(root) else SvgSource(path, root)
-    raise InputError(f"{path}: unknown input type '{suffix or path.name}'; expected a Lottie .json, .lottie "
-                     "or .tgs file, an .svg file, or a numbered SVG pattern such as frames/%04d.svg")
+    for reader in READERS:
+        if reader.takes(path):
+            return reader.open(path, split=split, fps=fps)
+    raise InputError(f"{path}: unknown input type '{path.suffix.lower() or path.name}'; expected a Lottie .json, "
+                     ".lottie or .tgs file, an .svg file, or a numbered SVG pattern such as frames/%04d.svg")
+
+
+def renderer_for(document: VectorDocument) -> Renderer:
+    """The default renderer of the document's kind: the first of :data:`RENDERERS` that draws it."""
+    for renderer in RENDERERS:
+        if document.kind in renderer.kinds:
+            return renderer
+    raise LookupError(f"no renderer draws {document.kind} documents")

@@ -1,13 +1,23 @@
-"""What every vector input offers the rasterize stage: layers, size, timing, rendering."""
+"""The vector protocol: a document (read from a file) and a renderer (draws its layers).
+
+A *reader* opens a file into a :class:`VectorDocument`: size, timing, named layers and the
+layers isolated at a time. A :class:`Renderer` turns a document's layers at a time in
+seconds into coverage. Readers and renderers are listed in tables in
+:mod:`fluidymation.stages.vector`.
+"""
 
 from __future__ import annotations
 
 import math
 from abc import ABC, abstractmethod
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
+
+from fluidymation.stages.files import is_sequence_pattern
 
 DEFAULT_FPS = 24.0
 
@@ -20,34 +30,74 @@ class VectorLayer:
     z: int
 
 
-class VectorSource(ABC):
-    """A vector animation: named layers that can be rendered alone at any frame and size.
+class VectorDocument(ABC):
+    """A vector animation as read from its file(s): named layers, size and timing.
 
-    Subclasses set ``path``, ``width``, ``height`` (native size, px), ``native_fps``
-    (None when the file has no frame rate) and ``layers`` (bottom to top), and implement
-    :meth:`default_range` and :meth:`render`.
+    Subclasses set ``path``, ``kind`` (lottie, dotlottie, tgs, svg, svg-smil,
+    svg-sequence), ``reader`` and ``reader_version`` (the reader that opened it),
+    ``width``, ``height`` (native size, px), ``native_fps`` (None when the file has no
+    frame rate), ``layers`` (bottom to top) and ``files`` (every file whose content is
+    read), and implement :meth:`frame_range` and :meth:`isolate`.
     """
 
-    kind: str
     path: Path
+    kind: str
+    reader: str
+    reader_version: int
     width: float
     height: float
     native_fps: float | None
     layers: list[VectorLayer]
+    files: list[Path]
 
     @abstractmethod
-    def default_range(self, fps: float) -> tuple[int, int]:
+    def frame_range(self, fps: float) -> tuple[int, int]:
         """The animation's own frames at ``fps``: (first, end exclusive)."""
 
     @abstractmethod
-    def render(self, names: list[str], frame: int, fps: float, size: tuple[int, int]) -> np.ndarray:
-        """Render only the layers ``names`` at scene ``frame`` (at ``fps``), size (W, H).
-
-        Returns (H, W, 4) uint8 premultiplied RGBA.
-        """
+    def isolate(self, names: Sequence[str], time_seconds: float) -> Any:
+        """Only the layers ``names`` as shown at ``time_seconds``, in the form this kind's renderers draw."""
 
     def layer_names(self) -> list[str]:
         return [layer.name for layer in self.layers]
+
+
+class Renderer(ABC):
+    """Draws layers of a document at a time; ``kinds`` lists the document kinds it can draw."""
+
+    name: str
+    version: int
+    kinds: tuple[str, ...]
+
+    @abstractmethod
+    def render(self, document: VectorDocument, layers: Sequence[str], time_seconds: float,
+               size: tuple[int, int]) -> np.ndarray:
+        """Only ``layers`` of ``document`` at ``time_seconds``, at ``size`` = (W, H) px.
+
+        Returns (H, W, 4) uint8 premultiplied RGBA; the alpha is the layers' coverage.
+        """
+
+
+@dataclass(frozen=True)
+class Reader:
+    """A row of the reader table: which paths a reader takes and how it opens them.
+
+    A path is taken when its suffix is one of ``suffixes``, it is a numbered pattern
+    (``frames/%04d.svg``) if ``sequence`` is set, and ``claims(path)`` (when given, a look
+    at the content) agrees. ``open(path, split=..., fps=...)`` returns the document.
+    """
+
+    name: str
+    version: int
+    suffixes: tuple[str, ...]
+    open: Callable[..., VectorDocument]
+    sequence: bool = False
+    claims: Callable[[Path], bool] | None = None
+
+    def takes(self, path: Path) -> bool:
+        """Whether this reader opens ``path``."""
+        return (path.suffix.lower() in self.suffixes and (not self.sequence or is_sequence_pattern(path.name))
+                and (self.claims is None or self.claims(path)))
 
 
 def frames_in(duration_seconds: float, fps: float) -> int:

@@ -58,3 +58,12 @@ def test_check_prints_the_resolved_scene(cli):
     assert code == 0, err
     assert "size:    256x256 px" in out and "fps:     24" in out and "frames:  0:48 (48 frames)" in out
     assert "body: z=0, selects body, colour #" in out and "arm: z=1, selects arm" in out
+    assert "reader:  lottie v1, renderer lottie-svg v1" in out
+
+
+@pytest.mark.parametrize("example,line", [("blob", "reader:  svg-smil v1, renderer lottie-svg v1"),
+                                          ("squiggle", "reader:  svg-sequence v1, renderer cairosvg v1")])
+def test_check_names_the_reader_and_renderer(cli, example, line):
+    code, out, err = cli("check", EXAMPLES / example / "scene.yaml")
+    assert code == 0, err
+    assert line in out

@@ -10,16 +10,17 @@ import numpy as np
 import pytest
 from lottie.exporters.cairo import export_png
 
-from fluidymation.stages.vector import open_vector
+from fluidymation.stages.vector import open_document, renderer_for
 
 DATA = Path(__file__).parent.parent / "data" / "lottie"
 EXAMPLES = Path(__file__).parents[2] / "examples"
 
 
-def coverage(source, names, frame, size=None, fps=None):
-    fps = fps or source.native_fps or 24
-    size = size or (round(source.width), round(source.height))
-    return source.render(list(names), frame, fps, size)[:, :, 3] / 255.0
+def coverage(document, names, frame, size=None, fps=None):
+    """Coverage of ``names`` at scene ``frame`` (at ``fps``, else the file's own), drawn by the default renderer."""
+    fps = fps or document.native_fps or 24
+    size = size or (round(document.width), round(document.height))
+    return renderer_for(document).render(document, names, frame / fps, size)[:, :, 3] / 255.0
 
 
 def box(mask):
@@ -36,55 +37,55 @@ def svg_circle(tmp_path, radius, size=200):
 
 @pytest.mark.parametrize("radius", [7.5, 20, 61])
 def test_svg_circle_covers_pi_r_squared(tmp_path, radius):
-    source = open_vector(svg_circle(tmp_path, radius))
-    area = coverage(source, ["disc"], 0).sum()
+    document = open_document(svg_circle(tmp_path, radius))
+    area = coverage(document, ["disc"], 0).sum()
     assert area == pytest.approx(np.pi * radius**2, rel=0.01)
 
 
 def test_circle_area_scales_with_output_size(tmp_path):
-    source = open_vector(svg_circle(tmp_path, 20, size=100))
-    area = coverage(source, ["disc"], 0, size=(300, 300)).sum()
+    document = open_document(svg_circle(tmp_path, 20, size=100))
+    area = coverage(document, ["disc"], 0, size=(300, 300)).sum()
     assert area == pytest.approx(np.pi * 60**2, rel=0.01)
 
 
 def test_lottie_circle_area_and_keyframed_position():
-    source = open_vector(DATA / "shapes_keyframe.json")
-    assert coverage(source, ["disc"], 0).sum() == pytest.approx(np.pi * 20**2, rel=0.01)
-    assert box(coverage(source, ["square"], 0) >= 0.5) == (10, 30, 10, 30)
-    assert box(coverage(source, ["square"], 5) >= 0.5) == (38, 58, 10, 30)
-    assert box(coverage(source, ["square"], 11) >= 0.5) == (66, 86, 10, 30)
+    document = open_document(DATA / "shapes_keyframe.json")
+    assert coverage(document, ["disc"], 0).sum() == pytest.approx(np.pi * 20**2, rel=0.01)
+    assert box(coverage(document, ["square"], 0) >= 0.5) == (10, 30, 10, 30)
+    assert box(coverage(document, ["square"], 5) >= 0.5) == (38, 58, 10, 30)
+    assert box(coverage(document, ["square"], 11) >= 0.5) == (66, 86, 10, 30)
 
 
 def test_lottie_keyframe_follows_scene_fps():
-    source = open_vector(DATA / "shapes_keyframe.json")  # 12 fps file
-    assert box(coverage(source, ["square"], 10, fps=24) >= 0.5) == (38, 58, 10, 30)  # 24 fps frame 10 = 12 fps frame 5
+    document = open_document(DATA / "shapes_keyframe.json")  # 12 fps file: its frame 5 is frame 10 at 24 fps
+    assert box(coverage(document, ["square"], 10, fps=24) >= 0.5) == (38, 58, 10, 30)
 
 
 def test_parented_layer_moves_with_its_parents():
-    source = open_vector(DATA / "parenting.json")
-    assert box(coverage(source, ["head"], 5) >= 0.5) == (44, 60, 23, 39)
-    assert box(coverage(source, ["torso"], 5) >= 0.5) == (42, 62, 41, 71)
-    assert coverage(source, ["head"], 5)[60, 52] == 0  # the torso is not drawn with the head
+    document = open_document(DATA / "parenting.json")
+    assert box(coverage(document, ["head"], 5) >= 0.5) == (44, 60, 23, 39)
+    assert box(coverage(document, ["torso"], 5) >= 0.5) == (42, 62, 41, 71)
+    assert coverage(document, ["head"], 5)[60, 52] == 0  # the torso is not drawn with the head
 
 
 def test_trim_path_draws_on():
-    source = open_vector(DATA / "trim_path.json")
-    assert coverage(source, ["line"], 0).sum() < 1
-    assert box(coverage(source, ["line"], 5) >= 0.5) == (16, 48, 44, 52)
-    assert box(coverage(source, ["line"], 10) >= 0.5) == (16, 80, 44, 52)
+    document = open_document(DATA / "trim_path.json")
+    assert coverage(document, ["line"], 0).sum() < 1
+    assert box(coverage(document, ["line"], 5) >= 0.5) == (16, 48, 44, 52)
+    assert box(coverage(document, ["line"], 10) >= 0.5) == (16, 80, 44, 52)
 
 
 def test_track_matte_is_applied_and_matte_source_is_not_drawn():
-    source = open_vector(DATA / "matte.json")
-    stripes = coverage(source, ["stripes"], 0) >= 0.5
+    document = open_document(DATA / "matte.json")
+    stripes = coverage(document, ["stripes"], 0) >= 0.5
     assert box(stripes) == (24, 72, 24, 72)
     assert stripes.sum() == pytest.approx(np.pi * 24**2, rel=0.02)
 
 
 def test_precomp_is_one_layer_unless_split():
-    whole = open_vector(DATA / "precomp.json")
+    whole = open_document(DATA / "precomp.json")
     assert whole.layer_names() == ["ground", "leaves"]
-    split = open_vector(DATA / "precomp.json", split=("leaves",))
+    split = open_document(DATA / "precomp.json", split=("leaves",))
     assert split.layer_names() == ["ground", "leaves/leaf_b", "leaves/leaf_a"]
     leaf_a = coverage(split, ["leaves/leaf_a"], 0) >= 0.5
     assert box(leaf_a) == (24, 56, 56, 88)
@@ -93,11 +94,11 @@ def test_precomp_is_one_layer_unless_split():
 
 
 def test_packed_forms_match_plain_json():
-    plain = open_vector(DATA / "parenting.json")
-    tgs = open_vector(DATA / "parenting.tgs")
+    plain = open_document(DATA / "parenting.json")
+    tgs = open_document(DATA / "parenting.tgs")
     assert np.array_equal(coverage(plain, ["head"], 5), coverage(tgs, ["head"], 5))
-    dot = open_vector(DATA / "precomp.lottie")
-    assert np.array_equal(coverage(open_vector(DATA / "precomp.json"), ["ground"], 3), coverage(dot, ["ground"], 3))
+    dot = open_document(DATA / "precomp.lottie")
+    assert np.array_equal(coverage(open_document(DATA / "precomp.json"), ["ground"], 3), coverage(dot, ["ground"], 3))
 
 
 def test_svg_layers_are_top_level_groups_by_label_then_id(tmp_path):
@@ -106,10 +107,10 @@ def test_svg_layers_are_top_level_groups_by_label_then_id(tmp_path):
                     ' width="40" height="20"><rect width="40" height="20" fill="#fff"/>'
                     '<g id="g1" inkscape:label="Left"><rect width="20" height="20" fill="#f00"/></g>'
                     '<g id="right"><rect x="20" width="20" height="20" fill="#00f"/></g></svg>')
-    source = open_vector(path)
-    assert source.layer_names() == ["Left", "right"]
-    assert coverage(source, ["Left"], 0).sum() == pytest.approx(400)
-    assert coverage(source, ["Left", "right"], 0).sum() == pytest.approx(800)  # the background rect is no layer
+    document = open_document(path)
+    assert document.layer_names() == ["Left", "right"]
+    assert coverage(document, ["Left"], 0).sum() == pytest.approx(400)
+    assert coverage(document, ["Left", "right"], 0).sum() == pytest.approx(800)  # the background rect is no layer
 
 
 def test_svg_sequence_in_numeric_order(tmp_path):
@@ -117,14 +118,14 @@ def test_svg_sequence_in_numeric_order(tmp_path):
         (tmp_path / f"f{index}.svg").write_text(
             f'<svg xmlns="http://www.w3.org/2000/svg" width="40" height="10"><g id="bar">'
             f'<rect width="{index + 1}" height="10"/></g></svg>')
-    source = open_vector(tmp_path / "f%d.svg")
-    assert source.default_range(24) == (0, 4)
-    assert [coverage(source, ["bar"], f).sum() for f in range(4)] == pytest.approx([10, 20, 30, 110])
+    document = open_document(tmp_path / "f%d.svg", fps=24)
+    assert document.frame_range(24) == (0, 4)
+    assert [coverage(document, ["bar"], f).sum() for f in range(4)] == pytest.approx([10, 20, 30, 110])
 
 
 def test_smil_example_grows():
-    source = open_vector(EXAMPLES / "blob" / "blob.svg")
-    areas = [coverage(source, ["blob"], frame, size=(64, 64), fps=24).sum() for frame in (0, 24)]
+    document = open_document(EXAMPLES / "blob" / "blob.svg")
+    areas = [coverage(document, ["blob"], frame, size=(64, 64), fps=24).sum() for frame in (0, 24)]
     assert areas[1] > areas[0] * 1.2
 
 
@@ -167,9 +168,9 @@ CASES = [("shapes_keyframe.json", "square"), ("shapes_keyframe.json", "disc"), (
 
 @pytest.mark.parametrize("filename,layer", CASES)
 def test_masks_agree_with_lottie_rendering(filename, layer):
-    source = open_vector(DATA / filename)
+    document = open_document(DATA / filename)
     for frame in (0, 5, 11):
-        ours = coverage(source, [layer], frame) >= 0.5
+        ours = coverage(document, [layer], frame) >= 0.5
         reference = lottie_reference(DATA / filename, layer, frame) >= 0.5
         union = (ours | reference).sum()
         if union == 0:
@@ -180,8 +181,8 @@ def test_masks_agree_with_lottie_rendering(filename, layer):
 @pytest.mark.parametrize("layer", ["body", "arm"])
 def test_wave_example_agrees_with_lottie_rendering(layer):
     path = EXAMPLES / "wave" / "wave.json"
-    source = open_vector(path)
+    document = open_document(path)
     for frame in (0, 12, 30):
-        ours = coverage(source, [layer], frame) >= 0.5
+        ours = coverage(document, [layer], frame) >= 0.5
         reference = lottie_reference(path, layer, frame) >= 0.5
         assert (ours & reference).sum() / (ours | reference).sum() >= 0.99

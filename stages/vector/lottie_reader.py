@@ -1,12 +1,9 @@
-"""Lottie animations (.json, dotLottie .lottie, Telegram .tgs) and SMIL-animated SVG.
+"""The Lottie reader: .json, dotLottie .lottie and Telegram .tgs files, read safely.
 
-Everything is rendered through the ``lottie`` package's SVG builder and cairosvg. To
-render some layers alone, every other layer is turned into a null layer that keeps its
-index, parent and transform, so parenting still works; a track-matte source needed by a
-kept layer is kept too. A precomp layer named in ``split`` is replaced by its children,
-named ``precomp/child``. An SVG with SMIL animation is imported with the lottie package's
-SVG importer, which turns each top-level ``<g>`` into a group of one shape layer; those
-groups are the layers.
+A :class:`LottieDocument` isolates layers for its renderers: every other layer is turned
+into a null layer that keeps its index, parent and transform, so parenting still works; a
+track-matte source needed by a kept layer is kept too. A precomp layer named in ``split``
+is replaced by its children, named ``precomp/child``.
 """
 
 from __future__ import annotations
@@ -18,16 +15,14 @@ import json
 import math
 import zipfile
 from dataclasses import dataclass
+from fractions import Fraction
 from pathlib import Path
-from xml.etree import ElementTree
+from typing import NamedTuple
 
 import lottie.objects
-from lottie.parsers.svg.builder import to_svg
-from lottie.parsers.svg.importer import parse_svg_etree
 
 from fluidymation.errors import InputError
-from fluidymation.stages.vector.base import VectorLayer, VectorSource, frames_in
-from fluidymation.stages.vector.raster import render_svg
+from fluidymation.stages.vector.base import Reader, VectorDocument, VectorLayer, frames_in
 from fluidymation.stages.vector.safety import (
     gunzip_limited,
     read_file,
@@ -36,6 +31,7 @@ from fluidymation.stages.vector.safety import (
 )
 
 _PRECOMP, _NULL = 0, 3
+_MAX_DENOMINATOR = 10**6
 _IMAGE_TYPES = {"png": "image/png", "jpg": "image/jpeg", "jpeg": "image/jpeg", "webp": "image/webp",
                 "gif": "image/gif", "svg": "image/svg+xml"}
 
@@ -49,16 +45,28 @@ class _Unit:
     group: int | None = None
 
 
-class LottieSource(VectorSource):
-    """A Lottie animation whose layers can be rendered alone."""
+class LottieFrame(NamedTuple):
+    """Layers of a Lottie document isolated at a time: the animation in which only they draw, and its frame."""
 
-    def __init__(self, path: Path, data: dict, *, kind: str, split: tuple[str, ...] = (),
+    animation: lottie.objects.Animation
+    frame: float
+
+
+class LottieDocument(VectorDocument):
+    """A Lottie animation (``data``, its JSON) whose layers can be drawn alone.
+
+    With ``groups_as_layers`` the groups of top-level shape layers are the layers (an
+    imported SMIL SVG).
+    """
+
+    def __init__(self, path: Path, data: dict, *, kind: str, reader: Reader, split: tuple[str, ...] = (),
                  native_fps: float | None = None, groups_as_layers: bool = False):
         self.path = path
         self.kind = kind
+        self.reader, self.reader_version = reader.name, reader.version
+        self.files = [path]
         self.data = data
-        self.source = str(path)
-        animation = _load_animation(data, self.source)
+        animation = _load_animation(data, str(path))
         self.width, self.height = float(animation.width), float(animation.height)
         self.lottie_fps = float(animation.frame_rate)
         self.native_fps = native_fps
@@ -68,23 +76,33 @@ class LottieSource(VectorSource):
         self.layers = [VectorLayer(name, z) for z, name in enumerate(names_bottom_up)]
         self._animations: dict[tuple[str, ...], lottie.objects.Animation] = {}
 
-    def default_range(self, fps: float) -> tuple[int, int]:
+    def frame_range(self, fps: float) -> tuple[int, int]:
         start = math.floor(self.in_point * fps / self.lottie_fps + 1e-6)
         end = frames_in(self.out_point / self.lottie_fps, fps)
         return start, max(end, start + 1)
 
-    def render(self, names, frame, fps, size):
+    def lottie_frame(self, time_seconds: float) -> float:
+        """The Lottie frame shown at ``time_seconds``: the time times the file's frame rate.
+
+        Scene frame k at f fps arrives as the float k/f. The product is taken on the
+        fraction nearest that float with a denominator up to 10**6, which is k/f itself, so
+        for whole-number rates it is k·fr/f to the bit and a scene frame that falls on a
+        file frame lands on it exactly (layer in and out points, hold keyframes), where the
+        float product alone can miss it by a unit in the last place.
+        """
+        time = Fraction(time_seconds).limit_denominator(_MAX_DENOMINATOR)
+        return float(time * Fraction(self.lottie_fps))
+
+    def isolate(self, names, time_seconds) -> LottieFrame:
         key = tuple(sorted(names))
         if key not in self._animations:
             isolated = _isolate(self.data, [self._units[name] for name in key])
-            self._animations[key] = _load_animation(isolated, self.source)
-        lottie_frame = frame * self.lottie_fps / fps
-        svg = ElementTree.tostring(to_svg(self._animations[key], lottie_frame).getroot())
-        return render_svg(svg, size, self.source)
+            self._animations[key] = _load_animation(isolated, str(self.path))
+        return LottieFrame(self._animations[key], self.lottie_frame(time_seconds))
 
 
-def open_lottie(path: Path, *, split: tuple[str, ...] = ()) -> LottieSource:
-    """Open a .json, .lottie or .tgs file."""
+def open_lottie(path: Path, *, split: tuple[str, ...] = (), fps: float | None = None) -> LottieDocument:
+    """Open a .json, .lottie or .tgs file (``fps`` is not needed: the file has its own)."""
     suffix = path.suffix.lower()
     raw = read_file(path)
     if suffix == ".tgs":
@@ -95,17 +113,11 @@ def open_lottie(path: Path, *, split: tuple[str, ...] = ()) -> LottieSource:
         data = _parse_json(raw, str(path))
     _check_structure(data, str(path))
     _check_assets(data, str(path))
-    return LottieSource(path, data, kind={".tgs": "tgs", ".lottie": "dotlottie"}.get(suffix, "lottie"),
-                        split=split, native_fps=float(data["fr"]))
+    return LottieDocument(path, data, kind={".tgs": "tgs", ".lottie": "dotlottie"}.get(suffix, "lottie"),
+                          reader=READER, split=split, native_fps=float(data["fr"]))
 
 
-def open_smil_svg(path: Path, root: ElementTree.Element) -> LottieSource:
-    """Import an SVG with SMIL animation through the lottie package's SVG importer."""
-    try:
-        animation = parse_svg_etree(ElementTree.ElementTree(root))
-    except Exception as exc:  # the importer raises many types on odd SVG
-        raise InputError(f"{path}: the SMIL animation cannot be imported ({type(exc).__name__}: {exc})") from None
-    return LottieSource(path, animation.to_dict(), kind="svg-smil", native_fps=None, groups_as_layers=True)
+READER = Reader("lottie", 1, (".json", ".lottie", ".tgs"), open_lottie)
 
 
 def _parse_json(raw: bytes, source: str) -> dict:

@@ -1,21 +1,22 @@
-"""Plain SVG: a static file (held over the frame range) or a numbered sequence of files.
+"""The plain-SVG readers: a static file (held over the frame range) or a numbered sequence of files.
 
 Layers are the top-level ``<g>`` elements of the root ``<svg>``, named by
-``inkscape:label`` or else ``id`` (``group N`` when neither is set). To render some layers
-alone, every other top-level drawable element is given ``display="none"``.
+``inkscape:label`` or else ``id`` (``group N`` when neither is set). To isolate some
+layers, every other top-level drawable element is given ``display="none"``.
 """
 
 from __future__ import annotations
 
 import copy
+import math
 import re
 from pathlib import Path
+from typing import NamedTuple
 from xml.etree import ElementTree
 
 from fluidymation.errors import InputError
 from fluidymation.stages.files import sequence_paths
-from fluidymation.stages.vector.base import VectorLayer, VectorSource
-from fluidymation.stages.vector.raster import render_svg
+from fluidymation.stages.vector.base import DEFAULT_FPS, Reader, VectorDocument, VectorLayer
 from fluidymation.stages.vector.safety import check_svg_references, local_name, parse_xml, read_file
 
 INKSCAPE_LABEL = "{http://www.inkscape.org/namespaces/inkscape}label"
@@ -94,46 +95,76 @@ def _isolated_svg(root: ElementTree.Element, names: list[str]) -> bytes:
     return ElementTree.tostring(root)
 
 
-class SvgSource(VectorSource):
-    """A static SVG: the same picture on every frame."""
+class SvgFrame(NamedTuple):
+    """Layers of an SVG document isolated at a time: the SVG to draw and the file it comes from."""
+
+    svg: bytes
+    source: str
+
+
+class SvgDocument(VectorDocument):
+    """A static SVG: the same picture at every time."""
 
     kind = "svg"
     native_fps = None
 
     def __init__(self, path: Path, root: ElementTree.Element):
         self.path = path
+        self.reader, self.reader_version = SVG_READER.name, SVG_READER.version
+        self.files = [path]
         self.root = root
         self.width, self.height = svg_size(root, str(path))
         self.layers = [VectorLayer(name, z) for z, name in enumerate(_layer_names(root))]
 
-    def default_range(self, fps):
+    def frame_range(self, fps):
         return 0, 1
 
-    def render(self, names, frame, fps, size):
-        return render_svg(_isolated_svg(self.root, names), size, str(self.path))
+    def isolate(self, names, time_seconds) -> SvgFrame:
+        return SvgFrame(_isolated_svg(self.root, names), str(self.path))
 
 
-class SvgSequenceSource(VectorSource):
-    """Numbered SVG files, one per frame; layers are those of the first file."""
+class SvgSequenceDocument(VectorDocument):
+    """Numbered SVG files, one per frame at ``fps``; layers are those of the first file."""
 
     kind = "svg-sequence"
     native_fps = None
 
-    def __init__(self, pattern: str, files: list[Path]):
+    def __init__(self, pattern: str, files: list[Path], fps: float):
         self.path = Path(pattern)
+        self.reader, self.reader_version = SEQUENCE_READER.name, SEQUENCE_READER.version
         self.files = files
+        self.fps = fps
         first = load_svg(files[0])
         self.width, self.height = svg_size(first, str(files[0]))
         self.layers = [VectorLayer(name, z) for z, name in enumerate(_layer_names(first))]
 
-    def default_range(self, fps):
+    def frame_range(self, fps):
         return 0, len(self.files)
 
-    def render(self, names, frame, fps, size):
+    def isolate(self, names, time_seconds) -> SvgFrame:
+        frame = math.floor(time_seconds * self.fps + 1e-6)
         if not 0 <= frame < len(self.files):
             raise InputError(f"{self.path}: frame {frame} is outside the sequence (0 to {len(self.files) - 1})")
         path = self.files[frame]
-        return render_svg(_isolated_svg(load_svg(path), names), size, str(path))
+        return SvgFrame(_isolated_svg(load_svg(path), names), str(path))
+
+
+def open_svg(path: Path, *, split: tuple[str, ...] = (), fps: float | None = None) -> SvgDocument:
+    """Open a static SVG file (``split`` and ``fps`` do not apply)."""
+    return SvgDocument(path, load_svg(path))
+
+
+def open_svg_sequence(pattern: Path, *, split: tuple[str, ...] = (), fps: float | None = None) -> SvgSequenceDocument:
+    """Open the numbered SVG files of ``pattern``: file k is shown from time k / ``fps``.
+
+    ``fps`` is the scene's frame rate; a sequence has none of its own, so None means
+    :data:`DEFAULT_FPS`, as for the scene.
+    """
+    return SvgSequenceDocument(str(pattern), sequence_files(pattern), fps or DEFAULT_FPS)
+
+
+SVG_READER = Reader("svg", 1, (".svg",), open_svg)
+SEQUENCE_READER = Reader("svg-sequence", 1, (".svg",), open_svg_sequence, sequence=True)
 
 
 def sequence_files(pattern: Path) -> list[Path]:
@@ -144,3 +175,4 @@ def sequence_files(pattern: Path) -> list[Path]:
     if len(files) > MAX_SEQUENCE_FILES:
         raise InputError(f"{pattern}: {len(files)} files is over the limit of {MAX_SEQUENCE_FILES} frames")
     return files
+
