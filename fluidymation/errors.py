@@ -18,3 +18,11 @@ class InputError(FluidymationError):
 
 class StageError(FluidymationError):
     """A stage cannot run with the inputs and parameters it was given."""
+
+
+class ParameterError(StageError):
+    """A stage or stylizer parameter has an invalid value; ``name`` says which, so callers can point at it."""
+
+    def __init__(self, name: str, message: str):
+        super().__init__(message)
+        self.name = name

@@ -57,7 +57,9 @@ def main(argv: list[str] | None = None) -> int:
     """Run the CLI with ``argv`` (default: ``sys.argv[1:]``) and return the exit code."""
     argv = sys.argv[1:] if argv is None else list(argv)
     debug = "--debug" in argv
-    logging.basicConfig(level=logging.DEBUG if debug else logging.WARNING, format="%(name)s: %(message)s")
+    logging.basicConfig(level=logging.WARNING, format="%(name)s: %(message)s")
+    # --debug: our own messages (stage keys, cache hits), not numba's compiler internals
+    logging.getLogger("fluidymation").setLevel(logging.DEBUG if debug else logging.WARNING)
     try:
         args = build_parser().parse_args(argv)
         use_json_lines(args.json)

@@ -93,6 +93,18 @@ def exemplar_identity(plan: Plan, layer: PlannedLayer) -> str:
     return _recording_identity(user_params(plan, name, spec), spec)
 
 
+def _stored_record(plan: Plan, layer: PlannedLayer, guide_params: guides.Params) -> str:
+    return json.dumps({"exemplar": exemplar_identity(plan, layer), "guides": dataclasses.asdict(guide_params),
+                       "version": guides.VERSION, "colour": exemplar_store.StoredSource.COLOUR_FILE}, sort_keys=True)
+
+
+def stored_identity(plan: Plan, layer: PlannedLayer, guide_params: guides.Params) -> str:
+    """A key that changes whenever the layer's stored exemplar would: the exemplar, its guides' parameters and
+    version (the name of its folder in the user cache)."""
+    record = _stored_record(plan, layer, guide_params)
+    return f"{exemplar_identity(plan, layer)}-{hashlib.sha256(record.encode()).hexdigest()[:12]}"
+
+
 def layer_source(plan: Plan, layer: PlannedLayer, guide_params: guides.Params, *,
                  progress=None) -> exemplar_store.StoredSource:
     """The layer's exemplar and its guides on disk, generated on first use and cached.
@@ -100,10 +112,8 @@ def layer_source(plan: Plan, layer: PlannedLayer, guide_params: guides.Params, *
     ``progress`` is called with no arguments after each simulated exemplar frame.
     """
     name, spec = exemplar_spec(plan, layer)
-    identity = exemplar_identity(plan, layer)
-    record = json.dumps({"exemplar": identity, "guides": dataclasses.asdict(guide_params), "version": guides.VERSION,
-                         "colour": exemplar_store.StoredSource.COLOUR_FILE}, sort_keys=True)
-    entry = paths.exemplar_guides_cache_dir() / f"{identity}-{hashlib.sha256(record.encode()).hexdigest()[:12]}"
+    record = _stored_record(plan, layer, guide_params)
+    entry = paths.exemplar_guides_cache_dir() / stored_identity(plan, layer, guide_params)
     if not (entry / "done").is_file():
         if spec["kind"] == "builtin":
             exemplar = exemplar_builtin.make_builtin_exemplar(builtin_params(plan, name, spec),

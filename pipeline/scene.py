@@ -11,8 +11,10 @@ import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from fluidymation.errors import SceneError
 from fluidymation.pipeline.schema import Checker
-from fluidymation.pipeline.yaml_lines import load_yaml
+from fluidymation.pipeline.stylizers import stylizer_names
+from fluidymation.pipeline.yaml_lines import KeyPath, LocatedYaml, load_yaml
 
 SCENE_VERSION = 1
 MAX_SIZE = 16384
@@ -22,7 +24,6 @@ MAX_FPS = 1000.0
 BACKGROUND_TYPES = ("synthesized", "solid", "image")
 BLEND_MODES = ("multiply", "over")
 PREVIEW_FORMATS = ("gif", "webp")
-STYLIZERS = ("fluidymation",)
 EXEMPLAR_KINDS = ("builtin", "video", "images")
 _LAYER_NAME = re.compile(r"^[A-Za-z0-9_][A-Za-z0-9_.\- ]*$")
 
@@ -67,6 +68,8 @@ class LayerSpec:
     blend: str
     opacity: float
     params: dict = field(default_factory=dict)
+    #: Where in the scene file each of ``params`` was given (its key path), for error messages.
+    param_paths: dict = field(default_factory=dict, compare=False)
 
 
 @dataclass(frozen=True)
@@ -84,6 +87,11 @@ class Scene:
     exemplars: dict
     layers: tuple[LayerSpec, ...] | None  # None: one scene layer per vector layer
     defaults: LayerSpec
+    doc: LocatedYaml = field(compare=False, repr=False)
+
+    def error(self, path: KeyPath, message: str) -> SceneError:
+        """A SceneError at ``path`` of the scene file: ``scene.yaml, line 12: layers[0].params.w_temp: message``."""
+        return Checker(self.doc).error(path, message)
 
     def layer(self, name: str) -> LayerSpec:
         """The scene layer called ``name`` (only for scenes that list their layers)."""
@@ -97,8 +105,6 @@ def load_scene(path: str | Path) -> Scene:
     """Load and validate the scene file at ``path``; raise SceneError on any problem."""
     path = Path(path)
     if path.is_dir():
-        from fluidymation.errors import SceneError
-
         raise SceneError(f"{path}: is a folder; give the scene's .yaml file")
     doc = load_yaml(path)
     check = Checker(doc)
@@ -125,6 +131,7 @@ def load_scene(path: str | Path) -> Scene:
         exemplars=exemplars,
         layers=_layers(check, exemplars, defaults),
         defaults=defaults,
+        doc=doc,
     )
 
 
@@ -254,11 +261,12 @@ def _layer(check: Checker, where, allowed, exemplars: dict, base: LayerSpec | No
         select=tuple(check.text_list(where + ("select",), None) or ([name] if name else [])),
         color=check.color(where + ("color",), None),
         exemplar=exemplar,
-        stylizer=check.text(where + ("stylizer",), base.stylizer if base else "fluidymation", choices=STYLIZERS),
+        stylizer=check.text(where + ("stylizer",), base.stylizer if base else "fluidymation", choices=stylizer_names()),
         colorize=colorize,
         blend=check.text(where + ("blend",), base.blend if base else "multiply", choices=BLEND_MODES),
         opacity=check.number(where + ("opacity",), base.opacity if base else 1.0, minimum=0, maximum=1),
         params=(dict(base.params) if base else {}) | params,
+        param_paths=(dict(base.param_paths) if base else {}) | {key: where + ("params", key) for key in params},
     )
 
 

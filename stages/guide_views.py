@@ -78,6 +78,10 @@ def _frame_range(frames, frame_count: int) -> range:
     return range(start, stop)
 
 
+#: The folders of the views, one PNG per frame in each (:func:`_write_frame`).
+VIEWS = ("flow", "ext_plus", "ext_minus", "shape", "dist", "segments")
+
+
 def _write_frame(out_dir: Path, number: int, guides: FrameGuides, meta: dict, raw: bool) -> None:
     name = f"{number:05d}"
     extent_top = max(meta["ext_plus_max"], meta["ext_minus_max"])

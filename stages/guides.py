@@ -30,7 +30,7 @@ from typing import Any, Callable, NamedTuple, Sequence, Union
 import numpy as np
 
 from fluidymation.engine import distance, extent, flow as flow_kernels
-from fluidymation.errors import StageError
+from fluidymation.errors import ParameterError, StageError
 from fluidymation.stages.flow_io import read_flow
 
 NAME = "guides"
@@ -88,7 +88,7 @@ class Params:
         )
         for name, valid, wanted in checks:
             if not valid:
-                raise StageError(f"guides: parameter {name} must be {wanted}, got {getattr(self, name)!r}")
+                raise ParameterError(name, f"guides: parameter {name} must be {wanted}, got {getattr(self, name)!r}")
 
 
 def map_frames(path: str | os.PathLike, start: int, stop: int, frame_shape: tuple, mode: str = "r") -> np.memmap:

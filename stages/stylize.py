@@ -39,7 +39,7 @@ from fluidymation.engine.shiftnnf import shift_nnf, temporal_modulation
 from fluidymation.engine.synthesis import SynthesisParams, TargetInputs, concatenate_prepared, synthesize_prepared
 from fluidymation.engine.synthesis import prepare_source as prepare_engine_source
 from fluidymation.engine.vote import vote
-from fluidymation.errors import StageError
+from fluidymation.errors import ParameterError, StageError
 from fluidymation.stages import guides
 from fluidymation.stages.exemplar_store import Source, StoredSource, border_clamped, concatenate
 
@@ -172,7 +172,7 @@ class Params:
         )
         for name, valid, wanted in checks:
             if not valid:
-                raise StageError(f"stylize: parameter {name} must be {wanted}, got {getattr(self, name)!r}")
+                raise ParameterError(name, f"stylize: parameter {name} must be {wanted}, got {getattr(self, name)!r}")
 
     @property
     def min_source_window(self) -> int:

@@ -1,8 +1,10 @@
 """``fluidymation ablate SCENE --layer NAME``: the paper's ablation study on one layer.
 
-The layer is stylized once with its full energy and once per term switched off (the
-weight set to 0): bound, dir, ext, temp, uni, and dir+bound together. The results go
-side by side, labelled, into one video, so the part each term plays can be seen.
+The layer is stylized once per variant of its stylizer's ablation study
+(:attr:`~fluidymation.stages.stylizer.Stylizer.ablation`): for ``fluidymation``, the full
+energy and each term switched off (the weight set to 0): bound, dir, ext, temp, uni, and
+dir+bound together. The results go side by side, labelled, into one video, so the part
+each term plays can be seen.
 """
 
 from __future__ import annotations
@@ -12,32 +14,22 @@ import dataclasses
 import numpy as np
 
 from fluidymation.errors import InputError
-from fluidymation.pipeline.parameters import layer_guide_params, layer_stylize_params
+from fluidymation.pipeline.layer_stages import stylize_layer
+from fluidymation.pipeline.parameters import layer_guide_params, layer_stylize_params, layer_stylizer
 from fluidymation.pipeline.progress import progress
-from fluidymation.pipeline.render import Options, load_layer_source, render, scaled_plan, stylize_layer
+from fluidymation.pipeline.render import Options, load_layer_source, render, scaled_plan
 from fluidymation.pipeline.resolve import parse_window, plan_scene
 from fluidymation.pipeline.scene import load_scene
 from fluidymation.stages import colorize, encode
 from fluidymation.stages.files import read_image
 from fluidymation.stages.labels import label_strip
 
-#: Each panel: its label and the weights it sets to 0 (none for the full energy).
-VARIANTS = (
-    ("full", ()),
-    ("no bound", ("w_bound",)),
-    ("no dir", ("w_dir",)),
-    ("no ext", ("w_ext",)),
-    ("no temp", ("w_temp",)),
-    ("no uni", ("w_uni",)),
-    ("no dir+bound", ("w_dir", "w_bound")),
-)
-
 
 def add_parser(subparsers) -> None:
     parser = subparsers.add_parser(
         "ablate", help="render a layer with each energy term switched off, side by side",
-        description="Stylize one layer with its full energy and with each term switched off (bound, dir, ext, "
-                    "temp, uni, dir+bound), write each version to <output.dir>/ablate/<layer>/<variant>/ and a "
+        description="Stylize one layer once per variant of its stylizer's ablation study (fluidymation: the "
+                    "full energy and each term switched off: bound, dir, ext, temp, uni, dir+bound), write each version to <output.dir>/ablate/<layer>/<variant>/ and a "
                     "labelled side-by-side video <output.dir>/ablate/<layer>.mp4. A term whose weight is already "
                     "0 for the layer gives no panel of its own.")
     parser.add_argument("scene", help="the scene's YAML file")
@@ -56,19 +48,22 @@ def run(args) -> int:
     out = render(plan, Options(until="masks", layers=(layer.name,), window=window, quiet=args.quiet,
                                  report=False))
     frames = plan.frames(window)
+    stylizer = layer_stylizer(plan, layer)
+    if not stylizer.ablation:
+        raise InputError(f"layer '{layer.name}': the stylizer '{stylizer.name}' defines no ablation study")
     guide_params = layer_guide_params(plan, layer)
     full = layer_stylize_params(plan, layer)
     source = load_layer_source(plan, layer, guide_params, args.quiet)
     paper = colorize.estimate_paper(source.rgb, source.segment)
     panels, skipped = [], []
-    for label, switched_off in VARIANTS:
+    for label, switched_off in stylizer.ablation:
         if switched_off and all(getattr(full, name) == 0 for name in switched_off):
             skipped.append(label)
             continue
         params = dataclasses.replace(full, **{name: 0.0 for name in switched_off})
         folder = out / "ablate" / layer.dirname / label.replace(" ", "-").replace("+", "-")
-        stylize_layer(plan, layer, frames, source, params, guide_params, coverage_dir=out / "coverage" / layer.dirname,
-                      out_dir=folder, quiet=args.quiet)
+        stylize_layer(plan, layer, frames, source, stylizer, params, guide_params,
+                      coverage_dir=out / "coverage" / layer.dirname, out_dir=folder, quiet=args.quiet)
         panels.append((label, folder))
     video = out / "ablate" / f"{layer.dirname}.mp4"
     labels = label_strip([label for label, _ in panels], width=plan.size[0])

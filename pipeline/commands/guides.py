@@ -5,7 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from fluidymation.errors import InputError
-from fluidymation.pipeline.render import write_layer_guides
+from fluidymation.pipeline.layer_stages import write_layer_guides
 from fluidymation.pipeline.resolve import parse_window, plan_scene
 from fluidymation.pipeline.scene import load_scene
 from fluidymation.stages.rasterize import Params as RasterParams

@@ -4,8 +4,9 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from fluidymation.pipeline.layer_stages import rasterize_layer
 from fluidymation.pipeline.progress import progress
-from fluidymation.pipeline.render import rasterize_layer, write_layers_summary
+from fluidymation.pipeline.render import write_layers_summary
 from fluidymation.pipeline.resolve import parse_window, plan_scene
 from fluidymation.pipeline.scene import load_scene
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from fluidymation.errors import InputError
 from fluidymation.pipeline.executors import LOCAL, dask_address
-from fluidymation.pipeline.render import STAGES, Options, render, scaled_plan
+from fluidymation.pipeline.render import STAGE_NAMES, Options, render, scaled_plan
 from fluidymation.pipeline.resolve import parse_window, plan_scene
 from fluidymation.pipeline.scene import load_scene
 
@@ -17,13 +17,13 @@ def add_parser(subparsers) -> None:
         description="Rasterize, stylize and colorize every layer, synthesize the paper, composite the layers "
                     "in z-order and encode the MP4 into the scene's output.dir, with report.json (timings "
                     "and cache hits per stage and layer). Work whose inputs and parameters are unchanged is "
-                    "taken from the stage cache (output.dir/.cache). Stages in order: " + ", ".join(STAGES) + ". Frame files are "
+                    "taken from the stage cache (output.dir/.cache). Stages in order: " + ", ".join(STAGE_NAMES) + ". Frame files are "
                     "numbered from the start of the scene's frame range. A killed render started again continues "
                     "from its last finished frame; renders of one scene running at once wait for and reuse each "
                     "other's work.")
     parser.add_argument("scene", help="the scene's YAML file")
-    parser.add_argument("--until", default=STAGES[-1], metavar="STAGE",
-                        help=f"last stage to run: {', '.join(STAGES)} (default: {STAGES[-1]})")
+    parser.add_argument("--until", default=STAGE_NAMES[-1], metavar="STAGE",
+                        help=f"last stage to run: {', '.join(STAGE_NAMES)} (default: {STAGE_NAMES[-1]})")
     parser.add_argument("--layer", action="append", metavar="NAME",
                         help="only (re-)render this layer (repeatable); the film is composited with the other "
                              "layers' earlier results")
@@ -50,8 +50,8 @@ def add_parser(subparsers) -> None:
 
 
 def run(args) -> int:
-    if args.until not in STAGES:
-        raise InputError(f"--until {args.until!r}: not a stage; choose one of {', '.join(STAGES)}")
+    if args.until not in STAGE_NAMES:
+        raise InputError(f"--until {args.until!r}: not a stage; choose one of {', '.join(STAGE_NAMES)}")
     if not 0 < args.scale <= 8:
         raise InputError(f"--scale {args.scale:g}: must be above 0 and at most 8")
     if args.jobs < 1:
@@ -65,7 +65,7 @@ def run(args) -> int:
     plan = scaled_plan(plan, args.scale * (PREVIEW_SCALE if args.preview else 1.0))
     out = render(plan, options)
     if not args.quiet:
-        done = out / plan.scene.output.video if args.until == STAGES[-1] else out
+        done = out / plan.scene.output.video if args.until == STAGE_NAMES[-1] else out
         print(f"rendered {plan.size[0]}x{plan.size[1]}, up to {args.until}: {done}")
     return 0
 

@@ -20,13 +20,14 @@ scene first loads (or compiles) numba's kernels; its time is shown as "warm-up".
 stage computes the target guides of the whole sequence and prepares the exemplar before
 its first frame, so the first frame's time includes them (the guides are also timed on
 their own beforehand); later frames are synthesis only. Parameters are
-configs/stylize.yaml's; exemplars are taken from (or generated into) the user cache.
+configs/fluidymation.yaml's; exemplars are taken from (or generated into) the user cache.
 ``--profile`` prints the child's cProfile.
 """
 
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
 import os
 import subprocess
@@ -100,11 +101,13 @@ def target_masks(shape, width, height):
 def run_case(name, profile, window=None, stored=None):
     """Child process: run one case (with ``source_window`` ``window``; the exemplar stored in ``stored``,
     or generated here), print one JSON line with its figures."""
-    from fluidymation.pipeline.parameters import stylize_defaults
+    from fluidymation.pipeline.parameters import default_params
+    from fluidymation.pipeline.stylizers import get_stylizer
     from fluidymation.stages import exemplar_store, guides, stylize
 
     (width, height), frame_count, (ex_width, ex_height, ex_frames), shape = CASES[name]
-    params = stylize.Params(**stylize_defaults() | {"source_window": window})
+    defaults = default_params(get_stylizer("fluidymation"))
+    params = dataclasses.replace(defaults, source_window=window)
     guide_params = guides.Params()
     masks = target_masks(shape, width, height)
     with tempfile.TemporaryDirectory() as folder:
@@ -112,7 +115,7 @@ def run_case(name, profile, window=None, stored=None):
         started = time.perf_counter()
         small = exemplar_source(48, 48, 6, guide_params, folder / "warm-source")
         for _ in stylize.stylize_sequence(ellipse_masks(64, 64, (20.0, 15.0)), 2, small,
-                                          params=stylize.Params(**stylize_defaults()), guide_params=guide_params,
+                                          params=defaults, guide_params=guide_params,
                                           cache_dir=folder / "warm"):
             pass
         del small

@@ -61,7 +61,7 @@ def test_full_render_writes_layers_frames_video_and_report(cli, tmp_path, monkey
     report = json.loads((root / "report.json").read_text())
     stages = [(entry["stage"], entry["layer"]) for entry in report["stages"]]
     assert stages == [("masks", "blob"), ("stylize", "blob"), ("colorize", "blob"), ("background", None),
-                      ("composite+encode", None)]
+                      ("encode", None)]
     assert report["frames"] == {"start": 4, "end": 7} and all(e["seconds"] >= 0 for e in report["stages"])
 
 

@@ -9,6 +9,7 @@ import numpy as np
 from fluidymation.engine.nnf import NNF
 from fluidymation.pipeline.cache import StageCache
 from fluidymation.pipeline.resume import FrameStates
+from fluidymation.stages.fluidymation_stylizer import FluidymationStylizer
 from fluidymation.stages.stylize import StylizedFrame
 
 from tests.scenes import blob_scene, write_scene
@@ -68,7 +69,7 @@ def _state(index, value):
 
 
 def test_the_resume_point_is_the_longest_finished_prefix_with_a_saved_state(tmp_path):
-    states = FrameStates(tmp_path)
+    states = FrameStates(tmp_path, FluidymationStylizer())
     states.save(_state(5, 0.5))
     states.save(_state(4, 0.25))  # processing in reverse: 5 then 4; 5's state is dropped
     assert sorted(path.name for path in tmp_path.iterdir()) == ["00004.npz"]

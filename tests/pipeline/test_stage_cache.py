@@ -5,8 +5,8 @@ import json
 from tests.scenes import blob_scene, write_scene
 
 
-def _write(tmp_path, blob_color="#2a6fdb", drop_exemplar="ink", size=40, frames=(4, 7)):
-    return write_scene(tmp_path, blob_scene(size=size, frames=frames,
+def _write(tmp_path, blob_color="#2a6fdb", drop_exemplar="ink"):
+    return write_scene(tmp_path, blob_scene(size=40, frames=(4, 7),
                                             layers=f'  - {{name: blob, color: "{blob_color}"}}\n'
                                                    f"  - {{name: drop, exemplar: {drop_exemplar}}}\n"))
 
@@ -19,15 +19,15 @@ def _ran(tmp_path):
 
 def test_unchanged_scene_recomputes_nothing(cli, tmp_path, monkeypatch):
     monkeypatch.setenv("FLUIDYMATION_CACHE", str(tmp_path / "cache"))
-    scene = _write(tmp_path, size=64, frames=(0, 12))  # a first render long enough (~1 s) to time reliably
+    scene = _write(tmp_path)
     assert cli("-q", "render", scene)[0] == 0
     first_ran, first = _ran(tmp_path)
     video = (tmp_path / "out" / "film.mp4").read_bytes()
-    assert ("stylize", "blob") in first_ran and ("composite+encode", None) in first_ran
+    assert first_ran == {(entry["stage"], entry["layer"]) for entry in first["stages"]}
+    assert {"stylize", "encode"} <= {stage for stage, _ in first_ran}
     assert cli("-q", "render", scene)[0] == 0
     ran, second = _ran(tmp_path)
-    assert ran == set() and second["cache_hits"] == len(second["stages"])
-    assert second["seconds"] < 0.1 * first["seconds"]
+    assert ran == set() and second["cache_hits"] == len(second["stages"]) == len(first["stages"])
     assert (tmp_path / "out" / "film.mp4").read_bytes() == video
 
 
@@ -36,7 +36,7 @@ def test_a_colour_change_redoes_only_that_layers_colorize_and_the_film(cli, tmp_
     assert cli("-q", "render", _write(tmp_path))[0] == 0
     assert cli("-q", "render", _write(tmp_path, blob_color="#d94f30"))[0] == 0
     ran, _ = _ran(tmp_path)
-    assert ran == {("colorize", "blob"), ("composite+encode", None)}
+    assert ran == {("colorize", "blob"), ("encode", None)}
 
 
 def test_an_exemplar_change_redoes_that_layers_stylize_onwards(cli, tmp_path, monkeypatch):
@@ -44,7 +44,7 @@ def test_an_exemplar_change_redoes_that_layers_stylize_onwards(cli, tmp_path, mo
     assert cli("-q", "render", _write(tmp_path))[0] == 0
     assert cli("-q", "render", _write(tmp_path, drop_exemplar="dry"))[0] == 0
     ran, _ = _ran(tmp_path)
-    assert ran == {("stylize", "drop"), ("colorize", "drop"), ("composite+encode", None)}
+    assert ran == {("stylize", "drop"), ("colorize", "drop"), ("encode", None)}
 
 
 def test_one_layer_rerendered_and_forced_stages(cli, tmp_path, monkeypatch):

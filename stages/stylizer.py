@@ -1,0 +1,108 @@
+"""What a stylizer implements: the plugin contract of the ``stylize`` stage.
+
+A stylizer turns a layer's coverage sequence and its exemplar into painted RGBA frames.
+Stylizers are found through the ``fluidymation.stylizers`` entry-point group (see
+docs/extending.md); a scene layer's ``stylizer:`` names one. Each brings:
+
+* ``name`` (the scene's ``stylizer:`` value) and ``version`` (part of the stylize key:
+  raise it whenever the same inputs would give other frames);
+* ``Params``, a frozen dataclass of its parameters, and ``defaults``, the YAML file of
+  their defaults (a ``params:`` mapping and an optional ``preview:`` one with the quicker
+  values of ``render --preview``). The scene's ``params:`` may set any field of
+  ``Params``; a field named ``seed`` takes the scene's seed unless a layer sets it;
+* :meth:`Stylizer.stylize`, a generator of :class:`StylizedFrame` objects (such as
+  :class:`Frame`), one per frame as soon as it is done, given a :class:`StylizeJob`;
+* the format of its per-frame state, so an interrupted render continues from its last
+  finished frame (:meth:`Stylizer.frame_state`, :meth:`Stylizer.resume_from`).
+
+The exemplar comes from :mod:`fluidymation.stages.exemplar_store`.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from abc import ABC, abstractmethod
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any, Callable, ClassVar, Iterator, NamedTuple, Protocol
+
+import numpy as np
+
+from fluidymation.stages import guides
+from fluidymation.stages.exemplar_store import StoredSource
+
+if TYPE_CHECKING:
+    from importlib.resources.abc import Traversable
+
+
+class StylizedFrame(Protocol):
+    """What a stylizer yields per frame: ``index`` (in the layer's sequence), ``rgba``
+    (H, W, 4) float32 in [0, 1] with the coverage as alpha, and ``nnf`` (an
+    :class:`~fluidymation.engine.nnf.NNF`, or None when the stylizer has none)."""
+
+    index: int
+    rgba: np.ndarray
+    nnf: Any
+
+
+class Frame(NamedTuple):
+    """The simplest :class:`StylizedFrame`: a frame's index and RGBA, without an NNF."""
+
+    index: int
+    rgba: np.ndarray
+    nnf: Any = None
+
+
+@dataclass(frozen=True)
+class StylizeJob:
+    """One layer's stylize work.
+
+    ``masks(j)`` gives frame j's (H, W) float32 coverage in [0, 1] for j in
+    ``0..frame_count−1``; ``frames`` = (first, stop) are the frames to yield; ``source``
+    is the layer's exemplar with its guides, made with ``guide_params``; ``cache_dir`` is
+    a scratch folder for the length of the job; ``resume`` is None or what
+    :meth:`Stylizer.resume_from` made of the state of the last finished frame.
+    """
+
+    masks: Callable[[int], np.ndarray]
+    frame_count: int
+    frames: tuple[int, int]
+    source: StoredSource
+    guide_params: guides.Params
+    cache_dir: str
+    resume: Any = None
+
+
+class Stylizer(ABC):
+    """Base of the stylizer plugins (see the module docstring)."""
+
+    name: ClassVar[str]
+    version: ClassVar[int]
+    Params: ClassVar[type]
+    defaults: ClassVar[Traversable | None] = None
+    #: Whether the layer's guide parameters (``blur_sigma``, ``border_width`` …) mean anything to it.
+    uses_guides: ClassVar[bool] = True
+    #: Whether its frames carry an NNF (``render --nnf``).
+    writes_nnf: ClassVar[bool] = False
+    #: The ablation study (``fluidymation ablate``): (label, parameters set to 0), the full energy first.
+    ablation: ClassVar[tuple[tuple[str, tuple[str, ...]], ...]] = ()
+
+    @classmethod
+    def parameter_names(cls) -> tuple[str, ...]:
+        """The scene ``params:`` keys it accepts: the fields of its ``Params``."""
+        return tuple(field.name for field in dataclasses.fields(cls.Params))
+
+    def processing_order(self, frames: range, params) -> list[int]:
+        """The frame indices of ``frames`` in the order :meth:`stylize` yields them (default: ascending)."""
+        return list(frames)
+
+    @abstractmethod
+    def stylize(self, job: StylizeJob, params) -> Iterator[StylizedFrame]:
+        """Yield the frames ``job.frames`` in :meth:`processing_order`, continuing after ``job.resume`` if given."""
+
+    def frame_state(self, frame: StylizedFrame) -> dict[str, np.ndarray]:
+        """What a resumed run needs of a finished ``frame``, as named arrays (saved atomically beside the frames)."""
+        return {}
+
+    def resume_from(self, index: int, state: dict[str, np.ndarray]) -> Any:
+        """``job.resume`` for continuing after frame ``index`` from its :meth:`frame_state`."""
+        return index
