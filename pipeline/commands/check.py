@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from fluidymation.pipeline.parameters import layer_stylizer
 from fluidymation.pipeline.resolve import Plan, plan_scene
 from fluidymation.pipeline.scene import load_scene
 from fluidymation.stages.rasterize import ColorTally, Params, rasterize_frame
@@ -45,5 +46,7 @@ def describe(plan: Plan) -> str:
             tally.add(rasterize_frame(renderer, document, layer.vector_layers, frame, params).rgba)
         found = tally.dominant() or "none (never visible in the sampled frames)"
         color = f"{layer.spec.color} (set in the scene; file: {found})" if layer.spec.color else found
-        lines.append(f"  {layer.name}: z={layer.z}, selects {', '.join(layer.vector_layers)}, colour {color}")
+        stylizer = layer_stylizer(plan, layer)
+        lines.append(f"  {layer.name}: z={layer.z}, selects {', '.join(layer.vector_layers)}, colour {color}, "
+                     f"stylizer {stylizer.name} v{stylizer.version}")
     return "\n".join(lines)

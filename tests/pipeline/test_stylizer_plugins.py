@@ -36,6 +36,8 @@ def test_a_stylizer_from_another_distribution_renders_a_layer(cli, tmp_path, mon
     monkeypatch.setenv("FLUIDYMATION_CACHE", str(tmp_path / "cache"))
     assert stylizers.stylizer_names() == ("flat", "fluidymation")
     scene = write_scene(tmp_path, blob_scene(layers=FLAT_LAYER, params="{}"))
+    code, out, _ = cli("check", scene)
+    assert code == 0 and "blob: z=" in out and "stylizer flat v1" in out
     code, _, err = cli("-q", "render", scene)
     assert code == 0, err
     out = tmp_path / "out"
