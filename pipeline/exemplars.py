@@ -21,7 +21,7 @@ import shutil
 import tempfile
 from pathlib import Path
 
-from fluidymation.errors import SceneError, StageError
+from fluidymation.errors import InputError, SceneError, StageError
 from fluidymation.pipeline import paths
 from fluidymation.pipeline.presets import resolve_params
 from fluidymation.pipeline.resolve import Plan, PlannedLayer
@@ -52,8 +52,11 @@ def builtin_params(plan: Plan, name: str, spec: dict) -> exemplar_builtin.Params
                          f"exemplars; they take seed, size, frames (a count), color and wetness")
     if isinstance(spec.get("frames"), tuple):
         raise SceneError(f"{plan.scene.path}: exemplars.{name}.frames: a builtin exemplar takes a frame count")
-    return resolve_params(spec["builtin"], seed=spec.get("seed"), size=spec.get("size"), frames=spec.get("frames"),
-                          color=spec.get("color"), wetness=spec.get("wetness"))
+    try:
+        return resolve_params(spec["builtin"], seed=spec.get("seed"), size=spec.get("size"), frames=spec.get("frames"),
+                              color=spec.get("color"), wetness=spec.get("wetness"))
+    except (InputError, StageError) as exc:
+        raise plan.scene.error(("exemplars", name), str(exc)) from None
 
 
 def simulated_frame_count(plan: Plan, layer: PlannedLayer) -> int | None:

@@ -231,8 +231,7 @@ def _colorize_settings(work) -> ColorizeSettings:
 
 def _run_colorize(work, key: str) -> Done:
     params = layer_colorize_params(work.layer, work.record["fill"])
-    files = colorize_layer(work.plan, work.layer, work.window, work.source, params, work.out, quiet=work.quiet)
-    return Done(files, manifest={"frames": work.frame_span})
+    return Done(colorize_layer(work.plan, work.layer, work.window, work.source, params, work.out, quiet=work.quiet))
 
 
 def layer_colorize_params(layer: PlannedLayer, fill_color: str | None) -> colorize.Params:
@@ -267,7 +266,8 @@ def colorize_layer(plan: Plan, layer: PlannedLayer, window: range, source: Store
 
 
 LAYER_STAGES = (
-    Stage("masks", LAYER, rasterize.VERSION, _mask_settings, _run_masks, inputs=_mask_inputs),
+    Stage("masks", LAYER, rasterize.VERSION, _mask_settings, _run_masks, inputs=_mask_inputs,
+          frames=lambda work: work.plan.frame_count),
     Stage("guides", LAYER, guides.VERSION, _guide_settings, _run_guides, upstream=("masks",)),
     Stage("stylize", LAYER, STYLIZE_VERSION, _stylize_settings, _run_stylize, inputs=_stylize_inputs,
           upstream=("masks",), repeats=("guides",)),

@@ -6,18 +6,42 @@ from __future__ import annotations
 import re
 from importlib import resources
 
-import yaml
-
 from fluidymation.errors import InputError
+from fluidymation.pipeline.schema import Checker
+from fluidymation.pipeline.yaml_lines import load_yaml
 from fluidymation.stages import exemplar_builtin
 
 _SIZE = re.compile(r"^(\d+)[xX](\d+)$")
 
 
+_PRESET_KEYS = ("seed", "size", "frames", "color", "wetness")
+#: The presets' defaults file.
+CONFIG = resources.files("fluidymation.configs").joinpath("exemplars.yaml")
+
+
 def preset_defaults() -> dict:
-    """Default parameters of every built-in preset, by name, from ``configs/exemplars.yaml``."""
-    text = resources.files("fluidymation.configs").joinpath("exemplars.yaml").read_text(encoding="utf-8")
-    return yaml.safe_load(text)["presets"]
+    """Default parameters of every built-in preset, by name, from ``configs/exemplars.yaml``.
+
+    The file is checked as a scene is: a bad key or value is a SceneError naming the file, line and key path.
+    """
+    with resources.as_file(CONFIG) as path:
+        check = Checker(load_yaml(path))
+    check.mapping((), ("version", "presets"), required=True)
+    presets = {}
+    for name in check.mapping(("presets",), None, required=True):
+        where = ("presets", name)
+        check.mapping(where, _PRESET_KEYS, required=True)
+        size = check.sequence(where + ("size",), required=True)
+        if len(size) != 2:
+            raise check.error(where + ("size",), "expected [width, height]")
+        presets[name] = {
+            "seed": check.integer(where + ("seed",), minimum=0),
+            "size": [check.integer(where + ("size", i), minimum=16, maximum=4096) for i in range(2)],
+            "frames": check.integer(where + ("frames",), minimum=2, maximum=10000),
+            "color": check.color(where + ("color",)),
+            "wetness": check.number(where + ("wetness",), minimum=0, maximum=1),
+        }
+    return presets
 
 
 def resolve_params(name: str, *, seed=None, size=None, frames=None, color=None, wetness=None) -> exemplar_builtin.Params:

@@ -175,8 +175,7 @@ class _Run:
         layer = None if work.layer is None else work.layer.name
         key = self.keys.key(stage.name, layer)
         where = stage.name if layer is None else f"{stage.name} {layer}"
-        frames = self.plan.frame_count if stage.name == "masks" else 1 if stage.name == "background" else len(
-            self.window)
+        frames = stage.frames(work)
         with self.cache.lock(stage.name, layer):
             started = time.perf_counter()
             forced = self.options.force or stage.name in self.options.force_stages

@@ -165,7 +165,8 @@ def _composite(work, *, encode_video: bool) -> Done:
 
 
 SCENE_STAGES = (
-    Stage("background", SCENE, background.VERSION, _background_settings, _run_background, inputs=_background_inputs),
+    Stage("background", SCENE, background.VERSION, _background_settings, _run_background, inputs=_background_inputs,
+          frames=lambda work: 1),
     Stage("composite", SCENE, composite.VERSION, _composite_settings, _run_composite,
           upstream=("colorize", "background")),
     Stage("encode", SCENE, encode.VERSION, _encode_settings, _run_encode, repeats=("composite",)),

@@ -41,13 +41,18 @@ def _no_inputs(work) -> dict:
     return {}
 
 
+def _window_frames(work) -> int:
+    return len(work.window)
+
+
 @dataclass(frozen=True)
 class Stage:
     """One stage of a render (see the module docstring).
 
     ``params(work)`` returns a frozen dataclass; ``inputs(work)`` a JSON-able mapping;
-    ``run(work, key)`` does the work and returns :class:`Done`. ``work`` is the render's
-    view of one layer (or of the scene, for scene stages).
+    ``run(work, key)`` does the work and returns :class:`Done`; ``frames(work)`` is the
+    number of frames it makes (for the report; default: the frames rendered). ``work`` is
+    the render's view of one layer (or of the scene, for scene stages).
     """
 
     name: str
@@ -58,6 +63,7 @@ class Stage:
     inputs: Callable[[Any], dict] = _no_inputs
     upstream: tuple[str, ...] = ()
     repeats: tuple[str, ...] = ()
+    frames: Callable[[Any], int] = _window_frames
 
     @property
     def depends_on(self) -> tuple[str, ...]:

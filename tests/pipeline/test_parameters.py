@@ -4,7 +4,7 @@ stylizer's defaults file."""
 import pytest
 
 from fluidymation.errors import SceneError
-from fluidymation.pipeline import parameters
+from fluidymation.pipeline import exemplars, parameters, presets
 from fluidymation.pipeline.resolve import plan_scene
 from fluidymation.pipeline.scene import load_scene
 from fluidymation.pipeline.stylizers import get_stylizer
@@ -64,3 +64,22 @@ def test_a_bad_defaults_file_is_reported_in_that_file(tmp_path, monkeypatch):
     config.write_text(text.replace("  w_temp:", "  w_tmp:"))
     error = _error(lambda: parameters.layer_stylize_params(plan, plan.layer("blob")))
     assert f"{config}, line {line}: params.w_tmp: unknown key 'w_tmp' (did you mean 'w_temp'?)" in error
+
+
+def test_a_builtin_exemplar_the_stage_refuses_is_reported_at_its_scene_entry(tmp_path):
+    plan = _plan(tmp_path, "  - {name: blob}\n")
+    scene = plan.scene.path
+    scene.write_text(scene.read_text().replace("size: [32, 32], frames: 6}", "size: [8, 8], frames: 6}", 1))
+    plan = plan_scene(load_scene(scene))
+    error = _error(lambda: exemplars.exemplar_identity(plan, plan.layer("blob")))
+    assert "line 9: exemplars.ink: exemplar size must be between 16 and 4096 pixels per side, got 8x8" in error
+
+
+def test_a_bad_preset_default_is_reported_in_the_presets_file(tmp_path, monkeypatch):
+    config = tmp_path / "exemplars.yaml"
+    text = presets.CONFIG.read_text()
+    config.write_text(text.replace("wetness: 0.5", "wetness: soggy", 1))
+    monkeypatch.setattr(presets, "CONFIG", config)
+    line = text.splitlines().index("    wetness: 0.5") + 1
+    error = _error(lambda: presets.resolve_params("watercolor-bloom"))
+    assert error.startswith(f"{config}, line {line}: presets.watercolor-bloom.wetness: expected a number")
