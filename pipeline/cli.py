@@ -43,6 +43,9 @@ def build_parser() -> argparse.ArgumentParser:
     )
     parser.add_argument("--version", action="version", version=f"fluidymation {__version__}")
     parser.add_argument("--debug", action="store_true", help="show tracebacks and detailed logs")
+    parser.add_argument("--strict", action="store_true",
+                        help="refuse inputs holding anything that cannot be rendered faithfully (by default a warning "
+                             "names each such element)")
     parser.add_argument("-q", "--quiet", action="store_true", help="no progress bars")
     parser.add_argument("--json", action="store_true",
                         help='progress as JSON lines on stderr ({"stage", "layer", "done", "total"}) instead of bars')
@@ -53,13 +56,27 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _configure_logging(debug: bool) -> None:
+    """Our messages (warnings; with ``--debug`` stage keys and cache hits) go to this run's stderr as
+    ``warning: ...``; other libraries' (numba's compiler internals) only from warnings up."""
+    logging.basicConfig(level=logging.WARNING, format="%(name)s: %(message)s")
+    logger = logging.getLogger("fluidymation")
+    for handler in [handler for handler in logger.handlers if getattr(handler, "cli", False)]:
+        logger.removeHandler(handler)
+    handler = logging.StreamHandler(sys.stderr)
+    handler.cli = True
+    handler.addFilter(lambda record: setattr(record, "level", record.levelname.lower()) or True)
+    handler.setFormatter(logging.Formatter("%(level)s: %(message)s"))
+    logger.addHandler(handler)
+    logger.setLevel(logging.DEBUG if debug else logging.WARNING)
+    logger.propagate = False
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run the CLI with ``argv`` (default: ``sys.argv[1:]``) and return the exit code."""
     argv = sys.argv[1:] if argv is None else list(argv)
     debug = "--debug" in argv
-    logging.basicConfig(level=logging.WARNING, format="%(name)s: %(message)s")
-    # --debug: our own messages (stage keys, cache hits), not numba's compiler internals
-    logging.getLogger("fluidymation").setLevel(logging.DEBUG if debug else logging.WARNING)
+    _configure_logging(debug)
     try:
         args = build_parser().parse_args(argv)
         use_json_lines(args.json)

@@ -7,12 +7,15 @@ is ``start``..``end`` (exclusive), and output files are numbered from ``start``.
 from __future__ import annotations
 
 import fnmatch
+import logging
 import re
 from dataclasses import dataclass, replace
 
-from fluidymation.errors import SceneError
+from fluidymation.errors import InputError, SceneError
 from fluidymation.pipeline.scene import MAX_FRAMES, MAX_SIZE, LayerSpec, Scene
 from fluidymation.stages.vector import DEFAULT_FPS, Renderer, VectorDocument, open_document, renderer_for
+
+log = logging.getLogger(__name__)
 
 
 @dataclass(frozen=True)
@@ -67,9 +70,14 @@ class Plan:
         return range(first, last)
 
 
-def plan_scene(scene: Scene) -> Plan:
-    """Open the scene's input, choose its renderer and work out frames, size and each layer's selection."""
+def plan_scene(scene: Scene, *, strict: bool = False) -> Plan:
+    """Open the scene's input, choose its renderer and work out frames, size and each layer's selection.
+
+    What the input holds that cannot be rendered faithfully is logged as a warning, each
+    naming the file and the element; with ``strict`` it is an InputError instead.
+    """
     document = open_document(scene.input, split=scene.split, fps=scene.fps)
+    report_unsupported(document, strict=strict)
     fps = scene.fps or document.native_fps or DEFAULT_FPS
     default_start, default_end = document.frame_range(fps)
     start = scene.frames.start if scene.frames else default_start
@@ -84,6 +92,18 @@ def plan_scene(scene: Scene) -> Plan:
                          f"({default_end} files)")
     return Plan(scene, document, renderer_for(document), fps, start, end, _size(scene, document),
                 _layers(scene, document))
+
+
+def report_unsupported(document: VectorDocument, *, strict: bool) -> None:
+    """Warn about each unsupported element of ``document``, or refuse them all with ``strict``."""
+    if not document.unsupported:
+        return
+    lines = [f"{document.path}: {item.element}: {item.message}" for item in document.unsupported]
+    if strict:
+        more = f" (and {len(lines) - 10} more)" if len(lines) > 10 else ""
+        raise InputError(f"--strict: {len(lines)} unsupported element(s):\n  " + "\n  ".join(lines[:10]) + more)
+    for line in lines:
+        log.warning("unsupported: %s", line)
 
 
 def parse_window(text: str | None) -> tuple[int | None, int | None] | None:

@@ -42,7 +42,7 @@ def add_parser(subparsers) -> None:
 def run(args) -> int:
     if not 0 < args.scale <= 8:
         raise InputError(f"--scale {args.scale:g}: must be above 0 and at most 8")
-    plan = scaled_plan(plan_scene(load_scene(args.scene)), args.scale)
+    plan = scaled_plan(plan_scene(load_scene(args.scene), strict=args.strict), args.scale)
     layer = plan.layer(args.layer)
     window = parse_window(args.frames)
     out = render(plan, Options(until="masks", layers=(layer.name,), window=window, quiet=args.quiet,

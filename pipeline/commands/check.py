@@ -19,7 +19,7 @@ def add_parser(subparsers) -> None:
 
 
 def run(args) -> int:
-    plan = plan_scene(load_scene(args.scene))
+    plan = plan_scene(load_scene(args.scene), strict=args.strict)
     print(describe(plan))
     return 0
 

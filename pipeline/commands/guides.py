@@ -31,7 +31,7 @@ def add_parser(subparsers) -> None:
 
 
 def run(args) -> int:
-    plan = plan_scene(load_scene(args.scene))
+    plan = plan_scene(load_scene(args.scene), strict=args.strict)
     layer = plan.layer(args.layer)
     window = plan.frames(parse_window(args.frames))
     out_dir = Path(args.output) if args.output else plan.scene.output.dir / "guides" / layer.dirname

@@ -23,7 +23,7 @@ def add_parser(subparsers) -> None:
 
 
 def run(args) -> int:
-    plan = plan_scene(load_scene(args.scene))
+    plan = plan_scene(load_scene(args.scene), strict=args.strict)
     frames = plan.frames(parse_window(args.frames))
     layers = [plan.layer(name) for name in args.layer] if args.layer else list(plan.layers)
     out_dir = Path(args.output) if args.output else plan.scene.output.dir / "masks"

@@ -61,7 +61,7 @@ def run(args) -> int:
                       window=parse_window(args.frames), preview=args.preview, nnf=args.nnf, quiet=args.quiet,
                       force=args.force, force_stages=tuple(args.force_stage), jobs=args.jobs,
                       executor=args.executor)
-    plan = plan_scene(load_scene(args.scene))
+    plan = plan_scene(load_scene(args.scene), strict=args.strict)
     plan = scaled_plan(plan, args.scale * (PREVIEW_SCALE if args.preview else 1.0))
     out = render(plan, options)
     if not args.quiet:

@@ -12,12 +12,12 @@ from pathlib import Path
 
 from fluidymation.errors import InputError
 from fluidymation.stages.vector import lottie_reader, smil_reader, svg_reader
-from fluidymation.stages.vector.base import DEFAULT_FPS, Reader, Renderer, VectorDocument, VectorLayer
+from fluidymation.stages.vector.base import DEFAULT_FPS, Reader, Renderer, Unsupported, VectorDocument, VectorLayer
 from fluidymation.stages.vector.cairosvg_renderer import CairoSvgRenderer
 from fluidymation.stages.vector.lottie_svg_renderer import LottieSvgRenderer
 
-__all__ = ["DEFAULT_FPS", "READERS", "RENDERERS", "Reader", "Renderer", "VectorDocument", "VectorLayer",
-           "open_document", "renderer_for"]
+__all__ = ["DEFAULT_FPS", "READERS", "RENDERERS", "Reader", "Renderer", "Unsupported", "VectorDocument",
+           "VectorLayer", "open_document", "renderer_for"]
 
 READERS: tuple[Reader, ...] = (
     svg_reader.SEQUENCE_READER,

@@ -23,6 +23,18 @@ DEFAULT_FPS = 24.0
 
 
 @dataclass(frozen=True)
+class Unsupported:
+    """Something in a vector file that a reader or renderer does not draw as the file means it.
+
+    ``element`` names it the way a user finds it in the file (``<animate id="spin">``,
+    ``layers[3] 'arm' (expression on the rotation)``); ``message`` says what is done instead.
+    """
+
+    element: str
+    message: str
+
+
+@dataclass(frozen=True)
 class VectorLayer:
     """A layer of the vector file: its name and z-order (0 = bottom, drawn first)."""
 
@@ -37,7 +49,8 @@ class VectorDocument(ABC):
     svg-sequence), ``reader`` and ``reader_version`` (the reader that opened it),
     ``width``, ``height`` (native size, px), ``native_fps`` (None when the file has no
     frame rate), ``layers`` (bottom to top) and ``files`` (every file whose content is
-    read), and implement :meth:`frame_range` and :meth:`isolate`.
+    read), and implement :meth:`frame_range` and :meth:`isolate`. ``unsupported`` lists
+    what the reader found it cannot render faithfully (warned about, refused with ``--strict``).
     """
 
     path: Path
@@ -49,6 +62,7 @@ class VectorDocument(ABC):
     native_fps: float | None
     layers: list[VectorLayer]
     files: list[Path]
+    unsupported: tuple[Unsupported, ...] = ()
 
     @abstractmethod
     def frame_range(self, fps: float) -> tuple[int, int]:
