@@ -1,8 +1,12 @@
-"""The plain-SVG readers: a static file (held over the frame range) or a numbered sequence of files.
+"""The plain-SVG readers: a single file (static, or animated) or a numbered sequence of files.
 
 Layers are the top-level ``<g>`` elements of the root ``<svg>``, named by
 ``inkscape:label`` or else ``id`` (``group N`` when neither is set). To isolate some
 layers, every other top-level drawable element is given ``display="none"``.
+
+A single file may hold animations: each parser of :data:`ANIMATIONS` looks for its kind
+(SMIL, CSS) and returns an :class:`Animation`; the document at a time is a copy of the
+file's tree with every animation applied at that time, in table order.
 """
 
 from __future__ import annotations
@@ -10,13 +14,14 @@ from __future__ import annotations
 import copy
 import math
 import re
+from abc import ABC, abstractmethod
 from pathlib import Path
-from typing import NamedTuple
+from typing import Callable, NamedTuple
 from xml.etree import ElementTree
 
 from fluidymation.errors import InputError
 from fluidymation.stages.files import sequence_paths
-from fluidymation.stages.vector.base import DEFAULT_FPS, Reader, VectorDocument, VectorLayer
+from fluidymation.stages.vector.base import DEFAULT_FPS, Reader, Unsupported, VectorDocument, VectorLayer, frames_in
 from fluidymation.stages.vector.safety import check_svg_references, local_name, parse_xml, read_file
 
 INKSCAPE_LABEL = "{http://www.inkscape.org/namespaces/inkscape}label"
@@ -95,6 +100,28 @@ def _isolated_svg(root: ElementTree.Element, names: list[str]) -> bytes:
     return ElementTree.tostring(root)
 
 
+class Animation(ABC):
+    """What changes an SVG document over time (one animation language), parsed from its file's tree."""
+
+    #: What it found in the file and cannot play faithfully.
+    unsupported: tuple[Unsupported, ...] = ()
+
+    @abstractmethod
+    def apply(self, at: Callable[[ElementTree.Element], ElementTree.Element], time_seconds: float) -> None:
+        """Set a fresh copy of the file's tree to how it shows at ``time_seconds``.
+
+        ``at(element)`` gives the copy of an element of the tree the animation was parsed from.
+        """
+
+    @abstractmethod
+    def duration(self) -> float:
+        """Seconds it takes to play once through (the document's default frame range)."""
+
+
+#: Parsers of the animation languages a file may hold: ``parse(root, source) -> Animation | None``.
+ANIMATIONS: tuple[Callable[[ElementTree.Element, str], Animation | None], ...] = ()
+
+
 class SvgFrame(NamedTuple):
     """Layers of an SVG document isolated at a time: the SVG to draw and the file it comes from."""
 
@@ -103,7 +130,7 @@ class SvgFrame(NamedTuple):
 
 
 class SvgDocument(VectorDocument):
-    """A static SVG: the same picture at every time."""
+    """An SVG file: the same picture at every time, unless it holds :data:`ANIMATIONS`."""
 
     kind = "svg"
     native_fps = None
@@ -115,12 +142,22 @@ class SvgDocument(VectorDocument):
         self.root = root
         self.width, self.height = svg_size(root, str(path))
         self.layers = [VectorLayer(name, z) for z, name in enumerate(_layer_names(root))]
+        self.animations = tuple(animation for parse in ANIMATIONS if (animation := parse(root, str(path))))
+        self.unsupported = tuple(item for animation in self.animations for item in animation.unsupported)
 
     def frame_range(self, fps):
-        return 0, 1
+        if not self.animations:
+            return 0, 1
+        return 0, frames_in(max(animation.duration() for animation in self.animations), fps)
 
     def isolate(self, names, time_seconds) -> SvgFrame:
-        return SvgFrame(_isolated_svg(self.root, names), str(self.path))
+        if not self.animations:
+            return SvgFrame(_isolated_svg(self.root, names), str(self.path))
+        copies: dict[int, object] = {}
+        root = copy.deepcopy(self.root, copies)
+        for animation in self.animations:
+            animation.apply(lambda element: copies[id(element)], time_seconds)
+        return SvgFrame(_isolated_svg(root, names), str(self.path))
 
 
 class SvgSequenceDocument(VectorDocument):
