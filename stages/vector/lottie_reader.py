@@ -1,19 +1,23 @@
 """The Lottie reader: .json, dotLottie .lottie and Telegram .tgs files, read safely.
 
-A :class:`LottieDocument` isolates layers for its renderers: every other layer is turned
-into a null layer that keeps its index, parent and transform, so parenting still works; a
-track-matte source needed by a kept layer is kept too. A precomp layer named in ``split``
-is replaced by its children, named ``precomp/child``.
+A :class:`LottieDocument` isolates layers for its renderers by editing the JSON: every
+other layer is marked hidden (``hd``), so it still parents the layers linked to it and
+expressions still find it, and a kept layer's track-matte source stays as it is (a matte
+source is never drawn itself). A precomp layer named in ``split`` is replaced by its
+children, named ``precomp/child``, isolated the same way inside a private copy of its
+precomposition. Image assets are embedded as ``data:`` URIs, read from the dotLottie
+archive or from files beside the input, so the player never opens a file itself.
+What the player (ThorVG) does not draw as the file means is listed in ``unsupported``.
 """
 
 from __future__ import annotations
 
 import base64
-import copy
 import fnmatch
 import json
 import math
 import zipfile
+from collections.abc import Callable
 from dataclasses import dataclass
 from fractions import Fraction
 from pathlib import Path
@@ -22,18 +26,29 @@ from typing import NamedTuple
 import lottie.objects
 
 from fluidymation.errors import InputError
-from fluidymation.stages.vector.base import Reader, VectorDocument, VectorLayer, frames_in
+from fluidymation.stages.vector.base import Reader, Unsupported, VectorDocument, VectorLayer, frames_in
 from fluidymation.stages.vector.safety import (
+    file_beside,
     gunzip_limited,
     read_file,
     read_zip_member,
     safe_zip_member_names,
 )
 
-_PRECOMP, _NULL = 0, 3
+_PRECOMP, _NULL, _TEXT = 0, 3, 5
 _MAX_DENOMINATOR = 10**6
 _IMAGE_TYPES = {"png": "image/png", "jpg": "image/jpeg", "jpeg": "image/jpeg", "webp": "image/webp",
                 "gif": "image/gif", "svg": "image/svg+xml"}
+_PLAYER_IMAGE_TYPES = {"image/png", "image/jpeg", "image/webp", "image/svg+xml"}
+# What ThorVG 1.0 does not draw (its Lottie parser skips these; checked in its source and on test files).
+_IGNORED_SHAPES = {"mm": "merge paths", "tw": "twist", "zz": "zig zag"}
+_MERGE_AS_DRAWN = {1, 2}  # merge and add: a group's paths filled together, as the player draws them anyway
+_DRAWN_SHAPES = {"gr", "rc", "el", "tr", "fl", "st", "sh", "sr", "rd", "gf", "gs", "tm", "rp", "pb", "op"}
+_UNDRAWN_LAYERS = {7: "video placeholder", 8: "image sequence", 9: "video", 10: "image placeholder",
+                   12: "adjustment layer", 13: "camera", 14: "light"}
+_DRAWN_EFFECTS = {20: "tint", 21: "fill", 22: "stroke", 23: "tritone", 25: "drop shadow", 29: "gaussian blur"}
+_DOTLOTTIE_ANIMATIONS, _DOTLOTTIE_IMAGES = ("animations", "a"), ("images", "i")
+_CUSTOM_EFFECT = 5  # an effect group: expression controls (drawn as nothing anyway) or a plug-in effect
 
 
 @dataclass(frozen=True)
@@ -45,8 +60,16 @@ class _Unit:
     group: int | None = None
 
 
+class PlayerFrame(NamedTuple):
+    """Layers of a Lottie document isolated for a player: the JSON in which only they draw, and the frame to show,
+    counted from the animation's in-point (as players count)."""
+
+    json: bytes
+    frame: float
+
+
 class LottieFrame(NamedTuple):
-    """Layers of a Lottie document isolated at a time: the animation in which only they draw, and its frame."""
+    """Layers of an imported SMIL SVG isolated for ``lottie-svg``: the lottie package's animation and its frame."""
 
     animation: lottie.objects.Animation
     frame: float
@@ -55,26 +78,29 @@ class LottieFrame(NamedTuple):
 class LottieDocument(VectorDocument):
     """A Lottie animation (``data``, its JSON) whose layers can be drawn alone.
 
-    With ``groups_as_layers`` the groups of top-level shape layers are the layers (an
-    imported SMIL SVG).
+    ``files`` are the file itself and the image files beside it that it uses. With
+    ``groups_as_layers`` the groups of top-level shape layers are the layers (an imported
+    SMIL SVG, drawn by ``lottie-svg``).
     """
 
     def __init__(self, path: Path, data: dict, *, kind: str, reader: Reader, split: tuple[str, ...] = (),
-                 native_fps: float | None = None, groups_as_layers: bool = False):
+                 native_fps: float | None = None, groups_as_layers: bool = False, images: tuple[Path, ...] = (),
+                 unsupported: tuple[Unsupported, ...] = ()):
         self.path = path
         self.kind = kind
         self.reader, self.reader_version = reader.name, reader.version
-        self.files = [path]
+        self.files = [path, *images]
         self.data = data
-        animation = _load_animation(data, str(path))
-        self.width, self.height = float(animation.width), float(animation.height)
-        self.lottie_fps = float(animation.frame_rate)
+        self.unsupported = unsupported
+        self.width, self.height = float(data["w"]), float(data["h"])
+        self.lottie_fps = float(data["fr"])
         self.native_fps = native_fps
-        self.in_point, self.out_point = float(animation.in_point), float(animation.out_point)
+        self.in_point, self.out_point = float(data["ip"]), float(data["op"])
+        self._groups_as_layers = groups_as_layers
         self._units = _units(data, split, groups_as_layers)
         names_bottom_up = list(reversed(list(self._units)))
         self.layers = [VectorLayer(name, z) for z, name in enumerate(names_bottom_up)]
-        self._animations: dict[tuple[str, ...], lottie.objects.Animation] = {}
+        self._isolated: dict[tuple[str, ...], bytes | lottie.objects.Animation] = {}
 
     def frame_range(self, fps: float) -> tuple[int, int]:
         start = math.floor(self.in_point * fps / self.lottie_fps + 1e-6)
@@ -93,12 +119,17 @@ class LottieDocument(VectorDocument):
         time = Fraction(time_seconds).limit_denominator(_MAX_DENOMINATOR)
         return float(time * Fraction(self.lottie_fps))
 
-    def isolate(self, names, time_seconds) -> LottieFrame:
+    def isolate(self, names, time_seconds) -> PlayerFrame | LottieFrame:
+        """A :class:`PlayerFrame`; for an imported SMIL SVG a :class:`LottieFrame` (lottie-svg draws those)."""
         key = tuple(sorted(names))
-        if key not in self._animations:
-            isolated = _isolate(self.data, [self._units[name] for name in key])
-            self._animations[key] = _load_animation(isolated, str(self.path))
-        return LottieFrame(self._animations[key], self.lottie_frame(time_seconds))
+        if key not in self._isolated:
+            isolated = _isolate(self.data, [self._units[name] for name in key],
+                                silence=_as_null if self._groups_as_layers else _hidden)
+            self._isolated[key] = (_load_animation(isolated, str(self.path)) if self._groups_as_layers
+                                   else json.dumps(isolated, separators=(",", ":")).encode())
+        if self._groups_as_layers:
+            return LottieFrame(self._isolated[key], self.lottie_frame(time_seconds))
+        return PlayerFrame(self._isolated[key], self.lottie_frame(time_seconds) - self.in_point)
 
 
 def open_lottie(path: Path, *, split: tuple[str, ...] = (), fps: float | None = None) -> LottieDocument:
@@ -112,12 +143,13 @@ def open_lottie(path: Path, *, split: tuple[str, ...] = (), fps: float | None = 
     else:
         data = _parse_json(raw, str(path))
     _check_structure(data, str(path))
-    _check_assets(data, str(path))
+    images = _embed_images_beside(data, path)
     return LottieDocument(path, data, kind={".tgs": "tgs", ".lottie": "dotlottie"}.get(suffix, "lottie"),
-                          reader=READER, split=split, native_fps=float(data["fr"]))
+                          reader=READER, split=split, native_fps=float(data["fr"]), images=images,
+                          unsupported=tuple(_unsupported(data)))
 
 
-READER = Reader("lottie", 1, (".json", ".lottie", ".tgs"), open_lottie)
+READER = Reader("lottie", 2, (".json", ".lottie", ".tgs"), open_lottie)
 
 
 def _parse_json(raw: bytes, source: str) -> dict:
@@ -133,6 +165,10 @@ def _parse_json(raw: bytes, source: str) -> dict:
 
 
 def _read_dotlottie(raw: bytes, path: Path) -> dict:
+    """The first animation of a dotLottie archive (the first of its manifest, else the first by name).
+
+    Both layouts are read: version 1 (``animations/``, ``images/``) and 2 (``a/``, ``i/``).
+    """
     import io
 
     source = str(path)
@@ -146,11 +182,12 @@ def _read_dotlottie(raw: bytes, path: Path) -> dict:
             if "manifest.json" in names else {}
         animations = manifest.get("animations") if isinstance(manifest.get("animations"), list) else []
         first = animations[0].get("id") if animations and isinstance(animations[0], dict) else None
-        candidates = [f"animations/{first}.json"] if first else []
-        candidates += sorted(n for n in names if n.startswith("animations/") and n.endswith(".json"))
+        candidates = [f"{folder}/{first}.json" for folder in _DOTLOTTIE_ANIMATIONS] if first else []
+        candidates += sorted(n for n in names if n.split("/")[0] in _DOTLOTTIE_ANIMATIONS and n.endswith(".json")
+                             and n.count("/") == 1)
         member = next((n for n in candidates if n in names), None)
         if member is None:
-            raise InputError(f"{source}: the dotLottie archive holds no animations/*.json")
+            raise InputError(f"{source}: the dotLottie archive holds no animations/*.json (or a/*.json)")
         data = _parse_json(read_zip_member(archive, member, source), f"{source}:{member}")
         _embed_archive_images(data, archive, names, source)
     return data
@@ -158,16 +195,50 @@ def _read_dotlottie(raw: bytes, path: Path) -> dict:
 
 def _embed_archive_images(data: dict, archive: zipfile.ZipFile, names: list[str], source: str) -> None:
     """Turn image assets stored inside a dotLottie archive into data: URIs."""
-    for asset in data.get("assets") or []:
-        if not isinstance(asset, dict) or "p" not in asset or asset.get("e") == 1:
+    for asset in _image_assets(data):
+        if asset.get("e") == 1 or str(asset["p"]).startswith("data:"):
             continue
-        member = (str(asset.get("u") or "").lstrip("/") + str(asset["p"])).lstrip("/")
-        if member not in names and f"images/{asset['p']}" in names:
-            member = f"images/{asset['p']}"
-        if member in names:
-            mime = _IMAGE_TYPES.get(member.rsplit(".", 1)[-1].lower(), "application/octet-stream")
-            encoded = base64.b64encode(read_zip_member(archive, member, source)).decode("ascii")
-            asset.update({"u": "", "p": f"data:{mime};base64,{encoded}", "e": 1})
+        named = (str(asset.get("u") or "").lstrip("/") + str(asset["p"])).lstrip("/")
+        member = next((m for m in (named, *(f"{folder}/{asset['p']}" for folder in _DOTLOTTIE_IMAGES))
+                       if m in names), None)
+        if member is not None:
+            _embed(asset, read_zip_member(archive, member, source), member)
+
+
+def _embed_images_beside(data: dict, path: Path) -> tuple[Path, ...]:
+    """Embed the image assets that name files beside the input (an After Effects export's ``images/``).
+
+    Returns the files read. URLs and paths leaving the input's folder are refused.
+    """
+    files = []
+    for index, asset in enumerate(data.get("assets") or []):
+        if not _is_image(asset):
+            continue
+        reference = str(asset["p"])
+        if reference.startswith("data:"):
+            asset["e"] = 1  # players read a data: URI only when the asset says it is embedded
+            continue
+        if asset.get("e") == 1:
+            raise InputError(f"{path}: assets[{index}] (id '{asset.get('id')}') is marked embedded but holds no "
+                             "data: URI")
+        image = file_beside(path.parent, str(asset.get("u") or "") + reference, str(path),
+                            f"assets[{index}] (id '{asset.get('id')}')")
+        _embed(asset, read_file(image), image.name)
+        files.append(image)
+    return tuple(dict.fromkeys(files))
+
+
+def _embed(asset: dict, content: bytes, name: str) -> None:
+    mime = _IMAGE_TYPES.get(name.rsplit(".", 1)[-1].lower(), "application/octet-stream")
+    asset.update({"u": "", "p": f"data:{mime};base64,{base64.b64encode(content).decode('ascii')}", "e": 1})
+
+
+def _is_image(asset) -> bool:
+    return isinstance(asset, dict) and "p" in asset and "layers" not in asset
+
+
+def _image_assets(data: dict) -> list[dict]:
+    return [asset for asset in data.get("assets") or [] if _is_image(asset)]
 
 
 def _check_structure(data: dict, source: str) -> None:
@@ -179,24 +250,21 @@ def _check_structure(data: dict, source: str) -> None:
         raise InputError(f"{source}: not a valid Lottie animation: w, h and fr must be positive")
     if data["op"] <= data["ip"]:
         raise InputError(f"{source}: the animation has no frames (op {data['op']} <= ip {data['ip']})")
-    if not isinstance(data.get("layers"), list):
-        raise InputError(f"{source}: not a valid Lottie animation: 'layers' must be a list")
-    for index, layer in enumerate(data["layers"]):
-        if not isinstance(layer, dict) or not isinstance(layer.get("ty"), int):
-            raise InputError(f"{source}: layers[{index}] is not a Lottie layer (needs an integer 'ty')")
+    _check_layers(data.get("layers"), "layers", source)
+    assets = data.get("assets", [])
+    if not isinstance(assets, list) or not all(isinstance(asset, dict) for asset in assets):
+        raise InputError(f"{source}: not a valid Lottie animation: 'assets' must be a list of objects")
+    for index, asset in enumerate(assets):
+        if "layers" in asset:
+            _check_layers(asset["layers"], f"assets[{index}].layers", source)
 
 
-def _check_assets(data: dict, source: str) -> None:
-    """Refuse image assets that point at files or URLs: only embedded data: URIs are allowed."""
-    for index, asset in enumerate(data.get("assets") or []):
-        if not isinstance(asset, dict) or "p" not in asset or "layers" in asset:
-            continue
-        reference = str(asset.get("p"))
-        if asset.get("e") == 1 or reference.startswith("data:"):
-            continue
-        where = (str(asset.get("u") or "") + reference) or "(empty)"
-        raise InputError(f"{source}: assets[{index}] (id '{asset.get('id')}') refers to the external image "
-                         f"'{where}'; Fluidymation never reads files named inside an input: embed the image")
+def _check_layers(layers, where: str, source: str) -> None:
+    if not isinstance(layers, list):
+        raise InputError(f"{source}: not a valid Lottie animation: '{where}' must be a list")
+    for index, layer in enumerate(layers):
+        if not isinstance(layer, dict) or isinstance(layer.get("ty"), bool) or not isinstance(layer.get("ty"), int):
+            raise InputError(f"{source}: {where}[{index}] is not a Lottie layer (needs an integer 'ty')")
 
 
 def _load_animation(data: dict, source: str) -> lottie.objects.Animation:
@@ -226,39 +294,153 @@ def _units(data: dict, split: tuple[str, ...], groups_as_layers: bool) -> dict[s
     return units
 
 
-def _isolate(data: dict, keep: list[_Unit]) -> dict:
-    """A copy of ``data`` in which only the ``keep`` units draw anything."""
-    data = copy.deepcopy(data)
+def _isolate(data: dict, keep: list[_Unit], *, silence: Callable[[dict], dict]) -> dict:
+    """A copy of ``data`` in which only the ``keep`` units draw; ``silence`` makes a layer that must not draw.
+
+    Kept layers keep their track-matte sources (which are never drawn themselves). Only
+    what changes is copied: the rest is shared with ``data``, which is never modified.
+    """
     layers = data["layers"]
     whole = {unit.layer for unit in keep if unit.child is None and unit.group is None}
     partial = {unit.layer for unit in keep} - whole
-    needed = whole | partial
-    needed |= {index - 1 for index in needed if index > 0 and layers[index].get("tt")}
-    for index, layer in enumerate(layers):
-        if index not in needed:
-            layers[index] = _as_null(layer)
-        elif index in partial:
-            _keep_parts(data, layer, [u for u in keep if u.layer == index], index)
-    return data
+    needed = _with_matte_sources(layers, whole | partial)
+    isolated = dict(data, layers=[layer if index in needed else silence(layer) for index, layer in enumerate(layers)],
+                    assets=list(data.get("assets") or []))
+    for index in sorted(partial):
+        isolated["layers"][index] = _keep_parts(isolated, layers[index], [u for u in keep if u.layer == index],
+                                                index, silence)
+    return isolated
 
 
-def _keep_parts(data: dict, layer: dict, keep: list[_Unit], index: int) -> None:
+def _keep_parts(isolated: dict, layer: dict, keep: list[_Unit], index: int, silence: Callable[[dict], dict]) -> dict:
+    """``layer`` drawing only the kept groups (an imported SMIL SVG) or the kept children of its precomp (``split``).
+
+    The children are isolated in a private copy of the precomp, added to ``isolated``'s assets.
+    """
     groups = {unit.group for unit in keep if unit.group is not None}
     if groups:
-        layer["shapes"] = [shape for i, shape in enumerate(layer.get("shapes") or [])
-                           if i in groups or shape.get("ty") != "gr"]
-    children = {unit.child for unit in keep if unit.child is not None}
-    if children:
-        asset = next(a for a in data["assets"] if a.get("id") == layer.get("refId"))
-        private = copy.deepcopy(asset)
-        private["id"] = f"{asset['id']}::isolated{index}"
-        kept = {c for c in children} | {c - 1 for c in children if c > 0 and private["layers"][c].get("tt")}
-        private["layers"] = [child if i in kept else _as_null(child) for i, child in enumerate(private["layers"])]
-        data["assets"].append(private)
-        layer["refId"] = private["id"]
+        return dict(layer, shapes=[shape for i, shape in enumerate(layer.get("shapes") or [])
+                                   if i in groups or shape.get("ty") != "gr"])
+    asset = next(a for a in isolated["assets"] if a.get("id") == layer.get("refId"))
+    children = asset["layers"]
+    kept = _with_matte_sources(children, {unit.child for unit in keep})
+    private = dict(asset, id=f"{asset['id']}::isolated{index}",
+                   layers=[child if i in kept else silence(child) for i, child in enumerate(children)])
+    isolated["assets"].append(private)
+    return dict(layer, refId=private["id"])
+
+
+def _with_matte_sources(layers: list[dict], indices: set[int]) -> set[int]:
+    """``indices`` and the track-matte sources they need, chained mattes too.
+
+    A matted layer (``tt``) takes its matte from the layer whose ``ind`` is its ``tp``
+    (Lottie 5.12 and later), else from the layer just above it.
+    """
+    by_ind = {layer.get("ind"): i for i, layer in enumerate(layers) if "ind" in layer}
+    needed, todo = set(indices), list(indices)
+    while todo:
+        index = todo.pop()
+        layer = layers[index]
+        if not layer.get("tt"):
+            continue
+        source = by_ind.get(layer["tp"]) if "tp" in layer else index - 1
+        if source is not None and source >= 0 and source not in needed:
+            needed.add(source)
+            todo.append(source)
+    return needed
+
+
+def _hidden(layer: dict) -> dict:
+    """``layer`` marked hidden: players draw nothing of it, but it still parents others and expressions find it."""
+    return dict(layer, hd=True)
 
 
 def _as_null(layer: dict) -> dict:
-    """A null layer that keeps ``layer``'s index, parent, timing and transform."""
+    """A null layer that keeps ``layer``'s index, parent, timing and transform (the lottie package hides the
+    children of a hidden layer, so lottie-svg needs this instead of :func:`_hidden`)."""
     kept = {key: layer[key] for key in ("ind", "parent", "ks", "ip", "op", "st", "sr", "nm") if key in layer}
     return kept | {"ty": _NULL, "ddd": 0}
+
+
+def _unsupported(data: dict) -> list[Unsupported]:
+    """What the player does not draw as the file means, each named where it is in the file."""
+    found = []
+    for index, asset in enumerate(data.get("assets") or []):
+        if isinstance(asset, dict) and "layers" in asset:
+            found += _unsupported_layers(asset["layers"], f"assets[{index}] '{asset.get('id')}' ", data)
+        elif _is_image(asset) and str(asset["p"]).startswith("data:"):
+            mime = str(asset["p"])[5:].split(";")[0]
+            if mime not in _PLAYER_IMAGE_TYPES:
+                found.append(Unsupported(f"assets[{index}] '{asset.get('id')}'",
+                                         f"a {mime} image, which the player does not draw"))
+    return _unsupported_layers(data["layers"], "", data) + found
+
+
+def _unsupported_layers(layers: list, where: str, data: dict) -> list[Unsupported]:
+    found = []
+    for index, layer in enumerate(layers):
+        name = f"{where}layers[{index}] '{layer.get('nm', '')}'"
+        kind = layer.get("ty")
+        if kind in _UNDRAWN_LAYERS:
+            found.append(Unsupported(name, f"a {_UNDRAWN_LAYERS[kind]}, which the player does not draw"))
+        if layer.get("ddd") == 1:
+            found.append(Unsupported(name, "a 3D layer: the player's 3D transform is partial"))
+        if layer.get("sy"):
+            found.append(Unsupported(name, "layer styles, which the player does not draw"))
+        for effect_index, effect in enumerate(_list(layer.get("ef"))):
+            if isinstance(effect, dict) and effect.get("en", 1) and not _drawn_effect(effect):
+                found.append(Unsupported(f"{name} ef[{effect_index}] '{effect.get('nm', '')}'",
+                                         f"effect type {effect.get('ty')}, which the player does not draw"))
+        found += _unsupported_shapes(_list(layer.get("shapes")), f"{name} shapes")
+        if kind == _TEXT:
+            found += _unsupported_text(layer, name, data)
+    return found
+
+
+def _drawn_effect(effect: dict) -> bool:
+    """Whether the player draws ``effect``, or there is nothing to draw (expression controls)."""
+    if effect.get("ty") == _CUSTOM_EFFECT:
+        match_name = str(effect.get("mn", ""))
+        return match_name.startswith("Pseudo/") or (match_name.startswith("ADBE ") and "Control" in match_name)
+    return effect.get("ty") in _DRAWN_EFFECTS
+
+
+def _unsupported_shapes(shapes: list, where: str) -> list[Unsupported]:
+    found = []
+    for index, shape in enumerate(shapes):
+        if not isinstance(shape, dict) or shape.get("hd"):
+            continue
+        name, kind = f"{where}[{index}] '{shape.get('nm', '')}'", shape.get("ty")
+        if kind == "mm" and shape.get("mm", 1) in _MERGE_AS_DRAWN:
+            continue
+        if kind in _IGNORED_SHAPES:
+            found.append(Unsupported(name, f"{_IGNORED_SHAPES[kind]}, which the player ignores: the shapes are "
+                                           "drawn without it"))
+        elif kind not in _DRAWN_SHAPES:
+            found.append(Unsupported(name, f"shape type {kind!r}, unknown to the player: not drawn"))
+        if kind == "gr":
+            found += _unsupported_shapes(_list(shape.get("it")), f"{name} it")
+    return found
+
+
+def _unsupported_text(layer: dict, name: str, data: dict) -> list[Unsupported]:
+    """Text in a font the player cannot draw: one the file neither embeds (``data:font/ttf``) nor gives glyphs of."""
+    fonts = {font.get("fName"): font for font in _list(_dict(data.get("fonts")).get("list")) if isinstance(font, dict)}
+    families = {char.get("fFamily") for char in _list(data.get("chars")) if isinstance(char, dict)}
+    keyframes = _list(_dict(_dict(layer.get("t")).get("d")).get("k"))
+    missing = []
+    for font_name in dict.fromkeys(str(_dict(key.get("s")).get("f")) for key in keyframes if isinstance(key, dict)):
+        font = _dict(fonts.get(font_name))
+        embedded = str(font.get("fPath", "")).startswith("data:font/ttf")
+        if not embedded and font.get("fFamily") not in families:
+            missing.append(font_name)
+    return [Unsupported(name, f"text in the font '{font_name}', which the file neither embeds nor gives glyphs of: "
+                              "the player draws no text") for font_name in missing]
+
+
+def _list(value) -> list:
+    return value if isinstance(value, list) else []
+
+
+def _dict(value) -> dict:
+    return value if isinstance(value, dict) else {}

@@ -2,7 +2,8 @@
 
 Nothing named inside an input file is ever fetched: SVG references outside the document
 (other than ``data:`` URIs) are refused with a clear error, and the rasterizer is given
-a fetcher that refuses everything but ``data:``.
+a fetcher that refuses everything but ``data:``. A Lottie file's image assets may name
+files beside it (:func:`file_beside`), never URLs or files elsewhere.
 """
 
 from __future__ import annotations
@@ -24,6 +25,7 @@ MAX_UNPACKED_BYTES = 64 * 2**20
 XLINK_HREF = "{http://www.w3.org/1999/xlink}href"
 _CSS_URL = re.compile(r"url\(\s*['\"]?\s*([^'\")\s]*)", re.IGNORECASE)
 _CSS_IMPORT = re.compile(r"@import", re.IGNORECASE)
+_URL_SCHEME = re.compile(r"^[A-Za-z][A-Za-z0-9+.-]+:")  # two letters at least: "C:" is a drive letter
 
 
 def read_file(path: Path, *, limit: int = MAX_FILE_BYTES) -> bytes:
@@ -39,6 +41,25 @@ def read_file(path: Path, *, limit: int = MAX_FILE_BYTES) -> bytes:
         raise InputError(f"{path}: is a folder, not a file") from None
     except OSError as exc:
         raise InputError(f"{path}: cannot be read ({exc.strerror})") from None
+
+
+def file_beside(folder: Path, reference: str, source: str, what: str) -> Path:
+    """The file that ``reference`` (a relative path named inside an input) names in the input's ``folder``.
+
+    A URL, an absolute path, or a path that leaves ``folder`` (``..``, a link pointing
+    elsewhere) is refused: an input may only use files beside it or in folders below.
+    """
+    if _URL_SCHEME.match(reference) or reference.startswith("//"):
+        raise InputError(f"{source}: {what} refers to the URL '{reference}'; Fluidymation never fetches URLs "
+                         "named inside an input: embed it or put the file beside the input")
+    root = folder.resolve()
+    target = (root / reference).resolve()
+    if PurePosixPath(reference.replace("\\", "/")).is_absolute() or not target.is_relative_to(root):
+        raise InputError(f"{source}: {what} refers to '{reference}', outside the input's folder {folder}; "
+                         "refused: only files beside the input (or in folders below it) are read")
+    if not target.is_file():
+        raise InputError(f"{source}: {what} refers to '{reference}', which is not a file in {folder}")
+    return target
 
 
 def gunzip_limited(data: bytes, source: str, *, limit: int = MAX_UNPACKED_BYTES) -> bytes:

@@ -58,7 +58,7 @@ def test_check_prints_the_resolved_scene(cli):
     assert code == 0, err
     assert "size:    256x256 px" in out and "fps:     24" in out and "frames:  0:48 (48 frames)" in out
     assert "body: z=0, selects body, colour #" in out and "arm: z=1, selects arm" in out
-    assert "reader:  lottie v1, renderer lottie-svg v1" in out
+    assert "reader:  lottie v2, renderer thorvg v1" in out
 
 
 @pytest.mark.parametrize("example,line", [("blob", "reader:  svg-smil v1, renderer lottie-svg v1"),

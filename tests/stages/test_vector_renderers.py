@@ -50,9 +50,9 @@ def bar_sequence(tmp_path, count):
 
 
 @pytest.mark.parametrize("path,reader,kind,renderer", [
-    (DATA / "parenting.json", "lottie", "lottie", "lottie-svg"),
-    (DATA / "parenting.tgs", "lottie", "tgs", "lottie-svg"),
-    (DATA / "precomp.lottie", "lottie", "dotlottie", "lottie-svg"),
+    (DATA / "parenting.json", "lottie", "lottie", "thorvg"),
+    (DATA / "parenting.tgs", "lottie", "tgs", "thorvg"),
+    (DATA / "precomp.lottie", "lottie", "dotlottie", "thorvg"),
     (EXAMPLES / "blob" / "blob.svg", "svg-smil", "svg-smil", "lottie-svg"),
     ("still.svg", "svg", "svg", "cairosvg"),
     (EXAMPLES / "squiggle" / "frames" / "%04d.svg", "svg-sequence", "svg-sequence", "cairosvg"),
@@ -78,7 +78,7 @@ def test_unknown_input_type_is_refused(tmp_path):
 def test_a_renderer_added_to_the_table_is_chosen_for_its_kinds(monkeypatch):
     monkeypatch.setattr("fluidymation.stages.vector.RENDERERS", (Stripes(), *RENDERERS))
     assert renderer_for(open_document(DATA / "parenting.json")).name == "stripes"
-    assert renderer_for(open_document(DATA / "parenting.tgs")).name == "lottie-svg"
+    assert renderer_for(open_document(DATA / "parenting.tgs")).name == "thorvg"
 
 
 def test_a_plugged_in_renderer_draws_the_plan(tmp_path):
