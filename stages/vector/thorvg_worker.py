@@ -41,9 +41,12 @@ class Player:
         picture = animation.get_picture()
         result = picture.load_data(data, "lottie", None, True)
         if result != self.tvg.Result.SUCCESS:
+            animation._del()
             raise ValueError(f"ThorVG cannot load the animation ({result.name})")
+        canvas = self.tvg.SwCanvas(self.engine)
+        canvas.add(picture)
         _, width, height = picture.get_size()
-        self.loaded[key] = {"animation": animation, "picture": picture, "canvas": None, "target": None,
+        self.loaded[key] = {"animation": animation, "picture": picture, "canvas": canvas, "target": None,
                             "size": (width, height)}
 
     def render(self, key: int, frame: float, width: int, height: int) -> bytes:
@@ -58,25 +61,20 @@ class Player:
         return bytes(canvas.buffer_arr)
 
     def _fit(self, entry: dict, width: int, height: int) -> None:
-        """A new canvas of ``width``×``height`` holding the picture scaled to fit and centred."""
-        if entry["canvas"] is not None:
-            entry["canvas"].remove(entry["picture"])
-            entry["canvas"].destroy()
-        canvas = self.tvg.SwCanvas(self.engine)
-        canvas.set_target(width, height, cs=self.tvg.Colorspace.ABGR8888)  # premultiplied; bytes R, G, B, A
+        """Draw into ``width``×``height``, the picture scaled to fit and centred."""
+        entry["canvas"].set_target(width, height, cs=self.tvg.Colorspace.ABGR8888)  # premultiplied; bytes R, G, B, A
         source_width, source_height = entry["size"]
         scale = min(width / source_width, height / source_height)
         picture = entry["picture"]
         picture.set_size(source_width * scale, source_height * scale)
         picture.translate((width - source_width * scale) / 2, (height - source_height * scale) / 2)
-        canvas.add(picture)
-        entry["canvas"], entry["target"] = canvas, (width, height)
+        entry["target"] = (width, height)
 
     def forget(self, key: int) -> None:
         entry = self.loaded.pop(key, None)
-        if entry is not None and entry["canvas"] is not None:
-            entry["canvas"].remove(entry["picture"])
+        if entry is not None:
             entry["canvas"].destroy()
+            entry["animation"]._del()
 
 
 def read_exactly(stream, count: int) -> bytes | None:
