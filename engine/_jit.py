@@ -4,17 +4,22 @@
 ``inline_kernel`` is a ``kernel`` inlined into its callers. All are
 cached on disk (``NUMBA_CACHE_DIR`` selects where) and use fastmath. Kernels that run
 in parallel must write disjoint slices so results do not depend on the thread count.
+``exact_kernel`` is a ``kernel`` without fastmath, for kernels whose results must not
+depend on where numpy happened to allocate their arrays (see its comment).
 ``prefetch`` asks the CPU to start loading an array element's cache line.
 ``threads_for`` runs the parallel kernels of small jobs on one thread.
+A kernel's disk cache is also keyed to the files of the kernels it calls from other modules.
 """
 
 import contextlib
+import os
 
 import numba
 from llvmlite import binding as llvm
 from llvmlite import ir
 from numba import types
-from numba.core import cgutils, codegen
+from numba.core import caching, cgutils, codegen
+from numba.core.dispatcher import Dispatcher
 from numba.extending import intrinsic
 
 
@@ -43,11 +48,59 @@ def _optimize_with_own_copies(library, _optimize=codegen.CPUCodeLibrary._optimiz
 
 codegen.CPUCodeLibrary._optimize_final_module = _optimize_with_own_copies
 
+
+def _key_cache_to_callees(cache, py_func, _init=caching.CacheImpl.__init__):
+    """Key a kernel's disk cache also to the source files of the kernels it calls.
+
+    Numba checks only the kernel's own file, but the cached code holds the kernel's own
+    copies of its callees (above): after an edit of engine/patch_cost.py, say, a process
+    loading the PatchMatch search from the cache would still run the old patch cost while
+    a fresh one compiles the new.
+    """
+    _init(cache, py_func)
+    own_stamp = cache._locator.get_source_stamp
+    callee_files = _callee_files(py_func)
+    cache._locator.get_source_stamp = lambda: (own_stamp(), *map(_file_stamp, callee_files))
+
+
+def _callee_files(py_func):
+    """The files of the kernels ``py_func``'s module refers to by name, of those their modules
+    refer to, and so on; ``py_func``'s own file left out."""
+    files = set()
+    namespaces = [py_func.__globals__]
+    seen = {id(py_func.__globals__)}
+    while namespaces:
+        for value in list(namespaces.pop().values()):
+            if isinstance(value, Dispatcher) and id(value.py_func.__globals__) not in seen:
+                seen.add(id(value.py_func.__globals__))
+                namespaces.append(value.py_func.__globals__)
+                files.add(value.py_func.__code__.co_filename)
+    files.discard(py_func.__code__.co_filename)
+    return sorted(files)
+
+
+def _file_stamp(path):
+    status = os.stat(path)
+    return caching._hash_source_file(path, status.st_mtime, status.st_size)
+
+
+caching.CacheImpl.__init__ = _key_cache_to_callees
+
 kernel = numba.njit(cache=True, fastmath=True, nogil=True)
 parallel_kernel = numba.njit(cache=True, fastmath=True, nogil=True, parallel=True)
 #: A ``kernel`` copied into each caller (no call with dozens of array fields per use;
 #: longer compilation): for small functions called in the innermost loops.
 inline_kernel = numba.njit(cache=True, fastmath=True, nogil=True, inline="always")
+#: A ``kernel`` with IEEE arithmetic (no fastmath). LLVM vectorizes a loop that writes one
+#: array while reading others behind a run-time check that the accessed address ranges do
+#: not overlap, and falls back to the scalar loop when they might (the ranges it checks
+#: run past the rows a loop really touches, so an output that numpy allocated right after
+#: an input fails the check). With fastmath's ``reassoc`` the vector and the scalar loop
+#: round differently, so results depended on the heap layout, which changes with the
+#: allocation history of the process (watercolor exemplars differed between two runs in
+#: one process, more often on a busy machine). Without fastmath both loops compute the
+#: same IEEE operations and give the same bits wherever the arrays are.
+exact_kernel = numba.njit(cache=True, nogil=True)
 
 
 @intrinsic

@@ -19,6 +19,9 @@ grows downwards; a positive ``u`` moves water to the right, a positive ``v`` dow
 The kernels are serial: each launch does little work (a relaxation sweep is a few
 hundred microseconds at 256²), so thread start-up and barriers would cost more than they
 save on a busy machine, and serial loops make the result independent of the thread count.
+They are compiled without fastmath (``exact_kernel``): with it, the vectorized and the
+scalar version of a loop rounded differently and which one ran depended on where the
+arrays lay in memory, so the same seed gave different exemplars.
 """
 
 from __future__ import annotations
@@ -29,7 +32,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy import ndimage
 
-from fluidymation.engine._jit import kernel
+from fluidymation.engine._jit import exact_kernel
 
 __all__ = [
     "WashParams",
@@ -238,7 +241,7 @@ def _as_field(value, name, shape=None):
 # --------------------------------------------------------------------------- kernels
 
 
-@kernel
+@exact_kernel
 def _zero_dry_faces(u, v, wet):
     height, width = wet.shape
     for y in range(height):
@@ -253,7 +256,7 @@ def _zero_dry_faces(u, v, wet):
                 v[y, x] = 0.0
 
 
-@kernel
+@exact_kernel
 def _apply_slope(u, v, paper_height, wet, slope):
     height, width = wet.shape
     for y in range(height):
@@ -266,7 +269,7 @@ def _apply_slope(u, v, paper_height, wet, slope):
                 v[y, x] -= slope * (paper_height[y, x] - paper_height[y - 1, x])
 
 
-@kernel
+@exact_kernel
 def _advance_velocities(u, v, pressure, wet, dt, viscosity, drag, max_speed, u_out, v_out):
     """One forward-Euler substep of the shallow-water momentum equation."""
     height, width = wet.shape
@@ -304,7 +307,7 @@ def _advance_velocities(u, v, pressure, wet, dt, viscosity, drag, max_speed, u_o
             v_out[y, x] = min(max(value, -max_speed), max_speed)
 
 
-@kernel
+@exact_kernel
 def _relax_divergence(u, v, pressure, wet, rate, tolerance, max_sweeps, delta, row_max):
     """Jacobi sweeps that remove divergence: δ = −ξ·div moves into p and the faces."""
     height, width = wet.shape
@@ -333,7 +336,7 @@ def _relax_divergence(u, v, pressure, wet, rate, tolerance, max_sweeps, delta, r
             break
 
 
-@kernel
+@exact_kernel
 def _advect_pigment(u, v, pigment, substeps, flux_x, flux_y):
     """Upwind flux-form advection: conserves mass, keeps pigment non-negative."""
     height, width = pigment.shape
@@ -352,7 +355,7 @@ def _advect_pigment(u, v, pigment, substeps, flux_x, flux_y):
                 pigment[y, x] += flux_x[y, x] - flux_x[y, x + 1] + flux_y[y, x] - flux_y[y + 1, x]
 
 
-@kernel
+@exact_kernel
 def _transfer_pigment(suspended, deposited, paper_height, wet, density, staining, granulation):
     height, width = wet.shape
     for y in range(height):
@@ -372,7 +375,7 @@ def _transfer_pigment(suspended, deposited, paper_height, wet, density, staining
             suspended[y, x] = g + up - down
 
 
-@kernel
+@exact_kernel
 def _capillary_share(source, target, target_capacity, diffuse_min, receive_min):
     """Saturation that moves from a cell with ``source`` to its neighbour with ``target``."""
     if source > diffuse_min and source > target and target > receive_min:
@@ -380,7 +383,7 @@ def _capillary_share(source, target, target_capacity, diffuse_min, receive_min):
     return 0.0
 
 
-@kernel
+@exact_kernel
 def _capillary_flow(
     saturation, capacity, wet, water, absorption, use_water, diffuse_min, receive_min, wet_threshold, snapshot, grown_rows
 ):
@@ -418,7 +421,7 @@ def _capillary_flow(
         grown_rows[y] = grown
 
 
-@kernel
+@exact_kernel
 def _evaporate(
     wet, wet_blur, water, saturation, suspended, deposited, pressure, rate, edge_boost, saturation_decay, dry_saturation,
     dried_rows,

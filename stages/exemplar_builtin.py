@@ -30,7 +30,7 @@ from fluidymation.errors import StageError
 from fluidymation.stages.colour import parse_hex
 
 NAME = "exemplar_builtin"
-VERSION = 1
+VERSION = 2  # 2: watercolor kernels without fastmath (results no longer depend on the heap layout)
 
 PAPER_COLOUR = (0.965, 0.945, 0.9)
 WET_DEEPENING = 0.3
