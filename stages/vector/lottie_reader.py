@@ -123,7 +123,7 @@ class LottieDocument(VectorDocument):
         """A :class:`PlayerFrame`; for an imported SMIL SVG a :class:`LottieFrame` (lottie-svg draws those)."""
         key = tuple(sorted(names))
         if key not in self._isolated:
-            isolated = _isolate(self.data, [self._units[name] for name in key],
+            isolated = _isolate(self.data, [unit for name in key for unit in self._units[name]],
                                 silence=_as_null if self._groups_as_layers else _hidden)
             self._isolated[key] = (_load_animation(isolated, str(self.path)) if self._groups_as_layers
                                    else json.dumps(isolated, separators=(",", ":")).encode())
@@ -222,7 +222,7 @@ def _embed_images_beside(data: dict, path: Path) -> tuple[Path, ...]:
             raise InputError(f"{path}: assets[{index}] (id '{asset.get('id')}') is marked embedded but holds no "
                              "data: URI")
         image = file_beside(path.parent, str(asset.get("u") or "") + reference, str(path),
-                            f"assets[{index}] (id '{asset.get('id')}')")
+                            f"assets[{index}] (id '{asset.get('id')}')", "image")
         _embed(asset, read_file(image), image.name)
         files.append(image)
     return tuple(dict.fromkeys(files))
@@ -274,23 +274,28 @@ def _load_animation(data: dict, source: str) -> lottie.objects.Animation:
         raise InputError(f"{source}: not a valid Lottie animation ({type(exc).__name__}: {exc})") from None
 
 
-def _units(data: dict, split: tuple[str, ...], groups_as_layers: bool) -> dict[str, _Unit]:
-    """Layer name -> where it lives, top of the stack first (Lottie order)."""
-    units: dict[str, _Unit] = {}
-    precomps = {asset.get("id"): asset for asset in data.get("assets") or [] if isinstance(asset, dict) and "layers" in asset}
+def _units(data: dict, split: tuple[str, ...], groups_as_layers: bool) -> dict[str, list[_Unit]]:
+    """Layer name -> where its layers live, top of the stack first (Lottie order).
+
+    Layers that share a name are one layer of the document (a user cannot tell them apart).
+    """
+    units: dict[str, list[_Unit]] = {}
+    precomps = {asset.get("id"): asset for asset in data.get("assets") or [] if "layers" in asset}
     for index, layer in enumerate(data["layers"]):
         name = str(layer.get("nm") or f"layer {index}")
         if groups_as_layers and layer["ty"] == 4:
             for group_index, shape in enumerate(layer.get("shapes") or []):
                 if shape.get("ty") == "gr":
-                    units.setdefault(str(shape.get("nm") or f"group {group_index}"), _Unit(index, group=group_index))
+                    units.setdefault(str(shape.get("nm") or f"group {group_index}"), []).append(
+                        _Unit(index, group=group_index))
             continue
         if layer["ty"] == _PRECOMP and any(fnmatch.fnmatchcase(name, pattern) for pattern in split):
             children = precomps.get(layer.get("refId"), {}).get("layers") or []
             for child_index, child in enumerate(children):
-                units.setdefault(f"{name}/{child.get('nm') or f'layer {child_index}'}", _Unit(index, child=child_index))
+                child_name = f"{name}/{child.get('nm') or f'layer {child_index}'}"
+                units.setdefault(child_name, []).append(_Unit(index, child=child_index))
             continue
-        units.setdefault(name, _Unit(index))
+        units.setdefault(name, []).append(_Unit(index))
     return units
 
 

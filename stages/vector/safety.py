@@ -43,22 +43,23 @@ def read_file(path: Path, *, limit: int = MAX_FILE_BYTES) -> bytes:
         raise InputError(f"{path}: cannot be read ({exc.strerror})") from None
 
 
-def file_beside(folder: Path, reference: str, source: str, what: str) -> Path:
+def file_beside(folder: Path, reference: str, source: str, what: str, kind: str) -> Path:
     """The file that ``reference`` (a relative path named inside an input) names in the input's ``folder``.
 
     A URL, an absolute path, or a path that leaves ``folder`` (``..``, a link pointing
     elsewhere) is refused: an input may only use files beside it or in folders below.
+    ``what`` names the referring element and ``kind`` the file (``image``) in the messages.
     """
     if _URL_SCHEME.match(reference) or reference.startswith("//"):
-        raise InputError(f"{source}: {what} refers to the URL '{reference}'; Fluidymation never fetches URLs "
-                         "named inside an input: embed it or put the file beside the input")
+        raise InputError(f"{source}: {what} refers to the external {kind} '{reference}', a URL; Fluidymation never "
+                         f"fetches URLs named inside an input: embed the {kind} or put it beside the input")
     root = folder.resolve()
     target = (root / reference).resolve()
     if PurePosixPath(reference.replace("\\", "/")).is_absolute() or not target.is_relative_to(root):
-        raise InputError(f"{source}: {what} refers to '{reference}', outside the input's folder {folder}; "
-                         "refused: only files beside the input (or in folders below it) are read")
+        raise InputError(f"{source}: {what} refers to the external {kind} '{reference}', outside the input's "
+                         f"folder {folder}; refused: only files beside the input (or in folders below it) are read")
     if not target.is_file():
-        raise InputError(f"{source}: {what} refers to '{reference}', which is not a file in {folder}")
+        raise InputError(f"{source}: {what} refers to the {kind} '{reference}', which is not a file in {folder}")
     return target
 
 

@@ -8,8 +8,8 @@ Each file is rendered at three frames of its own (in-point, one third and two th
 at SIZE×SIZE, in a child process per file and engine, so a native crash is counted, not
 fatal:
 
-* ``default``: our reader and its default renderer, every layer alone, the masks
-  (alpha ≥ 0.5) unioned, each layer-frame timed;
+* ``default``: our reader and its default renderer, every layer alone, their coverage
+  composited (alpha over alpha) and thresholded at 0.5, each layer-frame timed;
 * ``rlottie-layers``: the same isolated JSON drawn by rlottie (to compare the players
   on our isolation);
 * ``thorvg``, ``rlottie``: the whole file drawn by each reference player straight from
@@ -80,6 +80,12 @@ def fitted_alpha(rgba: np.ndarray) -> np.ndarray:
     return rgba[:, :, 3] >= 128
 
 
+def over(coverage: np.ndarray, rgba: np.ndarray) -> np.ndarray:
+    """The layers' coverage so far with one more layer drawn over it (so two translucent layers add up as in
+    the whole composition)."""
+    return 1 - (1 - coverage) * (1 - rgba[:, :, 3] / 255.0)
+
+
 # --- engines (each runs in its own child process) -------------------------------------------------------------
 
 def run_default(path: Path, size: int) -> dict:
@@ -92,13 +98,13 @@ def run_default(path: Path, size: int) -> dict:
         frames = file_frames(document.data)
         masks, times = [], []
         for frame in frames:
-            union = np.zeros((size, size), bool)
+            union = np.zeros((size, size))
             for name in document.layer_names():
                 start = time.perf_counter()
                 rgba = renderer.render(document, [name], frame / document.lottie_fps, (size, size))
                 times.append(time.perf_counter() - start)
-                union |= fitted_alpha(rgba)
-            masks.append(union)
+                union = over(union, rgba)
+            masks.append(union >= 0.5)
     except InputError as exc:
         status = "crashed" if "player crashed" in str(exc) else "hung" if "did not finish" in str(exc) else "refused"
         return {"status": status, "message": str(exc)[:300]}
@@ -127,13 +133,14 @@ def run_rlottie_layers(path: Path, size: int) -> dict:
         frames = file_frames(document.data)
         masks, times = [], []
         for frame in frames:
-            union = np.zeros((size, size), bool)
+            union = np.zeros((size, size))
             for name in document.layer_names():
                 isolated = document.isolate([name], frame / document.lottie_fps)
                 start = time.perf_counter()
-                union |= fitted_alpha(_rlottie_render(isolated.json, round(isolated.frame), size))
+                rgba = _rlottie_render(isolated.json, round(isolated.frame), size)
                 times.append(time.perf_counter() - start)
-            masks.append(union)
+                union = over(union, rgba)
+            masks.append(union >= 0.5)
     except (InputError, ValueError) as exc:
         return {"status": "refused", "message": str(exc)[:300]}
     return {"status": "ok", "masks": np.array(masks), "layer_frame_seconds": times}

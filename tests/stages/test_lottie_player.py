@@ -199,7 +199,7 @@ def test_image_beside_the_file_is_read_and_listed():
 @pytest.mark.parametrize("folder,name,message", [
     ("../", "dot.png", "outside the input's folder"),
     ("", "/etc/passwd", "outside the input's folder"),
-    ("https://example.com/", "dot.png", "refers to the URL 'https://example.com/dot.png'"),
+    ("https://example.com/", "dot.png", "refers to the external image 'https://example.com/dot.png', a URL"),
     ("images/", "missing.png", "which is not a file"),
 ])
 def test_image_assets_elsewhere_are_refused(tmp_path, folder, name, message):
