@@ -1,6 +1,6 @@
 """Vector animations: the reader table (files to documents) and the renderer table (documents to pixels).
 
-:func:`open_document` opens a Lottie (.json/.lottie/.tgs) or SVG (static, SMIL, numbered
+:func:`open_document` opens a Lottie (.json/.lottie/.tgs) or SVG (still, animated, numbered
 sequence) input with the first reader of :data:`READERS` that takes its path;
 :func:`renderer_for` picks the first renderer of :data:`RENDERERS` that draws the
 document's kind.
@@ -11,7 +11,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from fluidymation.errors import InputError
-from fluidymation.stages.vector import lottie_reader, smil_reader, svg_reader
+from fluidymation.stages.vector import lottie_reader, svg_reader
 from fluidymation.stages.vector.base import DEFAULT_FPS, Reader, Renderer, Unsupported, VectorDocument, VectorLayer
 from fluidymation.stages.vector.cairosvg_renderer import CairoSvgRenderer
 from fluidymation.stages.vector.lottie_svg_renderer import LottieSvgRenderer
@@ -23,7 +23,6 @@ __all__ = ["DEFAULT_FPS", "READERS", "RENDERERS", "Reader", "Renderer", "Unsuppo
 READERS: tuple[Reader, ...] = (
     svg_reader.SEQUENCE_READER,
     lottie_reader.READER,
-    smil_reader.READER,
     svg_reader.SVG_READER,
 )
 RENDERERS: tuple[Renderer, ...] = (ThorVGRenderer(), LottieSvgRenderer(), CairoSvgRenderer())

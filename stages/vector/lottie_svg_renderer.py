@@ -11,11 +11,11 @@ from fluidymation.stages.vector.raster import render_svg
 
 
 class LottieSvgRenderer(Renderer):
-    """Draws Lottie documents (and imported SMIL SVG) as the SVG of one frame, rasterized by cairosvg."""
+    """Draws Lottie documents as the SVG of one frame, rasterized by cairosvg."""
 
     name = "lottie-svg"
     version = 1
-    kinds = ("lottie", "dotlottie", "tgs", "svg-smil")
+    kinds = ("lottie", "dotlottie", "tgs")
 
     def render(self, document, layers, time_seconds, size):
         animation, frame = document.isolate(layers, time_seconds)

@@ -120,7 +120,7 @@ def check_svg_references(root: ElementTree.Element, source: str) -> None:
         tag = local_name(element.tag)
         for attribute in (XLINK_HREF, "href"):
             target = element.get(attribute)
-            if target is not None and not _internal(target):
+            if target is not None and not is_internal_reference(target):
                 raise InputError(f"{source}: <{tag}> refers to the external resource '{target}'; "
                                  "Fluidymation never fetches files or URLs named inside an input: "
                                  "embed it as a data: URI or remove it")
@@ -130,18 +130,19 @@ def check_svg_references(root: ElementTree.Element, source: str) -> None:
             if tag == "style" and _CSS_IMPORT.search(text):
                 raise InputError(f"{source}: <style> uses @import, which would load an external file; refused")
             for target in _CSS_URL.findall(text):
-                if not _internal(target):
+                if not is_internal_reference(target):
                     raise InputError(f"{source}: <{tag}> style refers to the external resource '{target}'; refused")
         for name, value in element.attrib.items():
             if name in (XLINK_HREF, "href", "style"):
                 continue
             for target in _CSS_URL.findall(value):
-                if not _internal(target):
+                if not is_internal_reference(target):
                     raise InputError(f"{source}: <{tag} {local_name(name)}> refers to the external resource "
                                      f"'{target}'; refused")
 
 
-def _internal(target: str) -> bool:
+def is_internal_reference(target: str) -> bool:
+    """Whether a reference stays inside the document: a fragment (``#id``), a ``data:`` URI or nothing."""
     target = target.strip()
     return target.startswith("#") or target.startswith("data:") or target == ""
 

@@ -1,8 +1,12 @@
 """The plain-SVG readers: a single file (static, or animated) or a numbered sequence of files.
 
 Layers are the top-level ``<g>`` elements of the root ``<svg>``, named by
-``inkscape:label`` or else ``id`` (``group N`` when neither is set). To isolate some
-layers, every other top-level drawable element is given ``display="none"``.
+``inkscape:label`` or else ``id`` (``group N`` when neither is set). A file without
+top-level groups has each top-level drawable element (shape, text, use, image, link,
+nested svg) as a layer, named by ``inkscape:label``, else ``id``, else its tag and its
+place among them (``circle 2``: the third). To isolate some layers, every other
+top-level drawable element is given ``display: none`` in its style (over any style sheet
+or animated value).
 
 A single file may hold animations: each parser of :data:`ANIMATIONS` looks for its kind
 (SMIL, CSS) and returns an :class:`Animation`; the document at a time is a copy of the
@@ -19,6 +23,8 @@ from pathlib import Path
 from typing import Callable, NamedTuple
 from xml.etree import ElementTree
 
+import tinycss2
+
 from fluidymation.errors import InputError
 from fluidymation.stages.files import sequence_paths
 from fluidymation.stages.vector.base import DEFAULT_FPS, Reader, Unsupported, VectorDocument, VectorLayer, frames_in
@@ -27,8 +33,8 @@ from fluidymation.stages.vector.safety import check_svg_references, local_name, 
 INKSCAPE_LABEL = "{http://www.inkscape.org/namespaces/inkscape}label"
 SVG_NAMESPACE = "http://www.w3.org/2000/svg"
 MAX_SEQUENCE_FILES = 100_000
-_NOT_DRAWN = {"defs", "style", "title", "desc", "metadata", "namedview", "script"}
-_SMIL_TAGS = {"animate", "animateTransform", "animateMotion", "animateColor", "set"}
+_DRAWN = {"g", "path", "rect", "circle", "ellipse", "line", "polyline", "polygon", "text", "use", "image", "svg",
+          "switch", "a", "foreignObject"}
 _UNITS_PX = {"": 1.0, "px": 1.0, "pt": 96 / 72, "pc": 16.0, "mm": 96 / 25.4, "cm": 96 / 2.54, "in": 96.0}
 _LENGTH = re.compile(r"^\s*([0-9.eE+-]+)\s*([a-z%]*)\s*$")
 
@@ -40,10 +46,6 @@ def load_svg(path: Path) -> ElementTree.Element:
         raise InputError(f"{path}: the root element is <{local_name(root.tag)}>, not <svg>")
     check_svg_references(root, str(path))
     return root
-
-
-def has_smil(root: ElementTree.Element) -> bool:
-    return any(local_name(element.tag) in _SMIL_TAGS for element in root.iter())
 
 
 def svg_size(root: ElementTree.Element, source: str) -> tuple[float, float]:
@@ -76,28 +78,55 @@ def _number(text: str) -> float | None:
         return None
 
 
+def _top_layers(root: ElementTree.Element) -> list[tuple[ElementTree.Element, str]]:
+    """The layers' elements and names: the top-level groups, or without any, the top-level drawable elements."""
+    drawn = [element for element in root if local_name(element.tag) in _DRAWN]
+    groups = [element for element in drawn if local_name(element.tag) == "g"]
+    if groups:
+        return [(element, element.get(INKSCAPE_LABEL) or element.get("id") or f"group {index}")
+                for index, element in enumerate(groups)]
+    return [(element, element.get(INKSCAPE_LABEL) or element.get("id") or f"{local_name(element.tag)} {index}")
+            for index, element in enumerate(drawn)]
+
+
 def _layer_names(root: ElementTree.Element) -> list[str]:
-    names = []
-    for index, element in enumerate(_top_groups(root)):
-        names.append(element.get(INKSCAPE_LABEL) or element.get("id") or f"group {index}")
-    return names
+    return [name for _, name in _top_layers(root)]
 
 
-def _top_groups(root: ElementTree.Element) -> list[ElementTree.Element]:
-    return [element for element in root if local_name(element.tag) == "g"]
-
-
-def _isolated_svg(root: ElementTree.Element, names: list[str]) -> bytes:
-    root = copy.deepcopy(root)
+def _hide_other_layers(root: ElementTree.Element, names: list[str]) -> bytes:
+    """The SVG of ``root`` (changed in place) with every top-level drawable element but the layers ``names`` hidden."""
     keep = set(names)
-    groups = {id(element): name for element, name in zip(_top_groups(root), _layer_names(root))}
+    kept = {id(element) for element, name in _top_layers(root) if name in keep}
     for element in root:
-        if local_name(element.tag) in _NOT_DRAWN:
-            continue
-        if groups.get(id(element)) not in keep:
-            element.set("display", "none")
+        if local_name(element.tag) in _DRAWN and id(element) not in kept:
+            set_style_property(element, "display", "none")
     ElementTree.register_namespace("", SVG_NAMESPACE)
     return ElementTree.tostring(root)
+
+
+def style_property(element: ElementTree.Element, name: str) -> str | None:
+    """The value the element's ``style`` attribute gives the CSS property ``name``, if any (the last one wins)."""
+    value = None
+    for declaration in _style_declarations(element):
+        if declaration.lower_name == name:
+            value = tinycss2.serialize(declaration.value).strip()
+    return value
+
+
+def set_style_property(element: ElementTree.Element, name: str, value: str) -> None:
+    """Set the CSS property ``name`` in the element's ``style`` attribute, in place of any declaration of it."""
+    kept = [f"{declaration.name}: {tinycss2.serialize(declaration.value).strip()}"
+            + (" !important" if declaration.important else "")
+            for declaration in _style_declarations(element) if declaration.lower_name != name]
+    element.set("style", "; ".join([*kept, f"{name}: {value}"]))
+
+
+def _style_declarations(element: ElementTree.Element) -> list:
+    style = element.get("style")
+    if not style:
+        return []
+    return [item for item in tinycss2.parse_blocks_contents(style, skip_whitespace=True, skip_comments=True)
+            if item.type == "declaration"]
 
 
 class Animation(ABC):
@@ -118,8 +147,10 @@ class Animation(ABC):
         """Seconds it takes to play once through (the document's default frame range)."""
 
 
+from fluidymation.stages.vector.smil import parse_smil  # noqa: E402  (it subclasses Animation)
+
 #: Parsers of the animation languages a file may hold: ``parse(root, source) -> Animation | None``.
-ANIMATIONS: tuple[Callable[[ElementTree.Element, str], Animation | None], ...] = ()
+ANIMATIONS: tuple[Callable[[ElementTree.Element, str], Animation | None], ...] = (parse_smil,)
 
 
 class SvgFrame(NamedTuple):
@@ -151,13 +182,11 @@ class SvgDocument(VectorDocument):
         return 0, frames_in(max(animation.duration() for animation in self.animations), fps)
 
     def isolate(self, names, time_seconds) -> SvgFrame:
-        if not self.animations:
-            return SvgFrame(_isolated_svg(self.root, names), str(self.path))
         copies: dict[int, object] = {}
         root = copy.deepcopy(self.root, copies)
         for animation in self.animations:
             animation.apply(lambda element: copies[id(element)], time_seconds)
-        return SvgFrame(_isolated_svg(root, names), str(self.path))
+        return SvgFrame(_hide_other_layers(root, names), str(self.path))
 
 
 class SvgSequenceDocument(VectorDocument):
@@ -183,11 +212,11 @@ class SvgSequenceDocument(VectorDocument):
         if not 0 <= frame < len(self.files):
             raise InputError(f"{self.path}: frame {frame} is outside the sequence (0 to {len(self.files) - 1})")
         path = self.files[frame]
-        return SvgFrame(_isolated_svg(load_svg(path), names), str(path))
+        return SvgFrame(_hide_other_layers(load_svg(path), names), str(path))
 
 
 def open_svg(path: Path, *, split: tuple[str, ...] = (), fps: float | None = None) -> SvgDocument:
-    """Open a static SVG file (``split`` and ``fps`` do not apply)."""
+    """Open an SVG file, still or animated (``split`` and ``fps`` do not apply)."""
     return SvgDocument(path, load_svg(path))
 
 
@@ -200,8 +229,8 @@ def open_svg_sequence(pattern: Path, *, split: tuple[str, ...] = (), fps: float 
     return SvgSequenceDocument(str(pattern), sequence_files(pattern), fps or DEFAULT_FPS)
 
 
-SVG_READER = Reader("svg", 1, (".svg",), open_svg)
-SEQUENCE_READER = Reader("svg-sequence", 1, (".svg",), open_svg_sequence, sequence=True)
+SVG_READER = Reader("svg", 2, (".svg",), open_svg)
+SEQUENCE_READER = Reader("svg-sequence", 2, (".svg",), open_svg_sequence, sequence=True)
 
 
 def sequence_files(pattern: Path) -> list[Path]:

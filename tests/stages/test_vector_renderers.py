@@ -53,7 +53,7 @@ def bar_sequence(tmp_path, count):
     (DATA / "parenting.json", "lottie", "lottie", "thorvg"),
     (DATA / "parenting.tgs", "lottie", "tgs", "thorvg"),
     (DATA / "precomp.lottie", "lottie", "dotlottie", "thorvg"),
-    (EXAMPLES / "blob" / "blob.svg", "svg-smil", "svg-smil", "lottie-svg"),
+    (EXAMPLES / "blob" / "blob.svg", "svg", "svg", "cairosvg"),
     ("still.svg", "svg", "svg", "cairosvg"),
     (EXAMPLES / "squiggle" / "frames" / "%04d.svg", "svg-sequence", "svg-sequence", "cairosvg"),
 ])
