@@ -196,7 +196,7 @@ class CssAnimation(Animation):
 
 def _parse_attribute(name: str, text: str):
     if name == "transform-origin":
-        return parse_origin(tokens(text))
+        return parse_origin(tokens(text), unitless=True)
     if name == "color":
         return _COLOR.parse(tokens(text))
     return PROPERTIES[name].kind.parse_attribute(text)

@@ -163,9 +163,9 @@ def _declaration(item, where: str, report: Report) -> list[Declaration]:
             return [Declaration(longhand, value, item.important) for longhand, value in parse_shorthand(values).items()]
         return [Declaration(name, parse_value(name, values), item.important)]
     except InvalidCss as exc:
-        report(where, f"'{name}: {text_of(values)}' is not valid CSS ({exc}); ignored, as browsers ignore it")
+        report(where, f"'{name}: {text_of(item.value)}' is not valid CSS ({exc}); ignored, as browsers ignore it")
     except UnsupportedCss as exc:
-        report(where, f"'{name}: {text_of(values)}': {exc}; ignored")
+        report(where, f"'{name}: {text_of(item.value)}': {exc}; ignored")
     return []
 
 
@@ -318,9 +318,9 @@ def _add_keyframe(keyframes: Keyframes, offsets: list[float], content, where: st
             elif not name.startswith("--"):
                 report(f"<style> @keyframes {keyframes.name}", f"property '{name}' is not animated; drawn without it")
         except InvalidCss as exc:
-            report(where, f"'{name}: {text_of(tokens)}' is not valid CSS ({exc}); ignored, as browsers ignore it")
+            report(where, f"'{name}: {text_of(item.value)}' is not valid CSS ({exc}); ignored, as browsers ignore it")
         except UnsupportedCss as exc:
-            report(where, f"'{name}: {text_of(tokens)}': {exc}; not animated")
+            report(where, f"'{name}: {text_of(item.value)}': {exc}; not animated")
     for offset in offsets:
         for name, value in values:
             keyframes.add(name, Keyframe(offset, value, easing))

@@ -59,8 +59,8 @@ def split_commas(values) -> list[list]:
 
 
 def text_of(values) -> str:
-    """``values`` serialized back to CSS text, for messages."""
-    return tinycss2.serialize(values).strip()
+    """``values`` serialized back to CSS text, for messages (a space where tinycss2 keeps tokens apart by a comment)."""
+    return tinycss2.serialize(values).replace("/**/", " ").strip()
 
 
 def check_computable(values) -> None:

@@ -146,16 +146,19 @@ def resolve(functions: tuple[Function, ...], box: Box) -> tuple[Function, ...]:
                  if function.name == "translate" else function for function in functions)
 
 
-def parse_origin(values) -> tuple[Length, Length]:
-    """``transform-origin``: one to three values (keywords, lengths, percentages); a z offset must be 0."""
+def parse_origin(values, *, unitless: bool = False) -> tuple[Length, Length]:
+    """``transform-origin``: one to three values (keywords, lengths, percentages); a z offset must be 0.
+
+    ``unitless`` takes bare numbers as px, as the SVG ``transform-origin`` attribute does.
+    """
     if len(values) == 3:
-        if length(values[2], unitless=False) != Length(0.0):
+        if length(values[2], unitless=unitless) != Length(0.0):
             raise UnsupportedCss("a 3D transform-origin (z offset) is not drawn")
         values = values[:2]
     if len(values) == 1:
         if ident(values[0]) in ("top", "bottom"):
-            return _CENTER, _origin_offset(values[0], "y")
-        return _origin_offset(values[0], "x"), _CENTER
+            return _CENTER, _origin_offset(values[0], "y", unitless)
+        return _origin_offset(values[0], "x", unitless), _CENTER
     if len(values) != 2:
         raise InvalidCss(f"'{text_of(values)}' is not a transform-origin")
     first, second = values
@@ -163,13 +166,13 @@ def parse_origin(values) -> tuple[Length, Length]:
         if ident(first) is None or ident(second) is None:
             raise InvalidCss(f"'{text_of(values)}' is not a transform-origin")
         first, second = second, first
-    return _origin_offset(first, "x"), _origin_offset(second, "y")
+    return _origin_offset(first, "x", unitless), _origin_offset(second, "y", unitless)
 
 
-def _origin_offset(value, axis: str) -> Length:
+def _origin_offset(value, axis: str, unitless: bool) -> Length:
     keyword = ident(value)
     if keyword is None:
-        return length(value, unitless=False)
+        return length(value, unitless=unitless)
     if keyword not in _ORIGIN_KEYWORDS[axis]:
         raise InvalidCss(f"'{keyword}' is not a transform-origin keyword for the {axis} axis")
     return Length(_ORIGIN_KEYWORDS[axis][keyword], True)

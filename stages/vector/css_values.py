@@ -138,7 +138,7 @@ class ColorKind(Kind):
             return Keyword("currentcolor")
         if parsed.space not in ("srgb", "hsl", "hwb"):
             raise UnsupportedCss(f"the colour '{text_of(values)}' ({parsed.space}) is not interpolated")
-        return tuple(parsed.to("srgb").params) + (parsed.alpha,)
+        return tuple(parsed.to("srgb").coordinates) + (parsed.alpha,)
 
     def resolve(self, value, context):
         return context.color if value == Keyword("currentcolor") else value
