@@ -48,6 +48,7 @@ _UNDRAWN_LAYERS = {7: "video placeholder", 8: "image sequence", 9: "video", 10: 
                    12: "adjustment layer", 13: "camera", 14: "light"}
 _DRAWN_EFFECTS = {20: "tint", 21: "fill", 22: "stroke", 23: "tritone", 25: "drop shadow", 29: "gaussian blur"}
 _DOTLOTTIE_ANIMATIONS, _DOTLOTTIE_IMAGES = ("animations", "a"), ("images", "i")
+_THEME_RULE_TYPES = {"Color", "Scalar", "Position", "Vector"}
 _CUSTOM_EFFECT = 5  # an effect group: expression controls (drawn as nothing anyway) or a plug-in effect
 
 
@@ -136,17 +137,19 @@ def open_lottie(path: Path, *, split: tuple[str, ...] = (), fps: float | None = 
     """Open a .json, .lottie or .tgs file (``fps`` is not needed: the file has its own)."""
     suffix = path.suffix.lower()
     raw = read_file(path)
+    theme_rules_skipped = []
     if suffix == ".tgs":
         data = _parse_json(gunzip_limited(raw, str(path)), str(path))
     elif suffix == ".lottie":
-        data = _read_dotlottie(raw, path)
+        data, theme_rules_skipped = _read_dotlottie(raw, path)
     else:
         data = _parse_json(raw, str(path))
     _check_structure(data, str(path))
+    _inline_slots(data)
     images = _embed_images_beside(data, path)
     return LottieDocument(path, data, kind={".tgs": "tgs", ".lottie": "dotlottie"}.get(suffix, "lottie"),
                           reader=READER, split=split, native_fps=float(data["fr"]), images=images,
-                          unsupported=tuple(_unsupported(data)))
+                          unsupported=tuple(theme_rules_skipped + _unsupported(data)))
 
 
 READER = Reader("lottie", 2, (".json", ".lottie", ".tgs"), open_lottie)
@@ -164,10 +167,12 @@ def _parse_json(raw: bytes, source: str) -> dict:
     return data
 
 
-def _read_dotlottie(raw: bytes, path: Path) -> dict:
+def _read_dotlottie(raw: bytes, path: Path) -> tuple[dict, list[Unsupported]]:
     """The first animation of a dotLottie archive (the first of its manifest, else the first by name).
 
-    Both layouts are read: version 1 (``animations/``, ``images/``) and 2 (``a/``, ``i/``).
+    Both layouts are read: version 1 (``animations/``, ``images/``) and 2 (``a/``, ``i/``,
+    themes in ``t/``). The animation's ``initialTheme`` is applied (:func:`_apply_theme`);
+    returned with the animation are the theme's rules that are not applied.
     """
     import io
 
@@ -190,7 +195,76 @@ def _read_dotlottie(raw: bytes, path: Path) -> dict:
             raise InputError(f"{source}: the dotLottie archive holds no animations/*.json (or a/*.json)")
         data = _parse_json(read_zip_member(archive, member, source), f"{source}:{member}")
         _embed_archive_images(data, archive, names, source)
-    return data
+        theme = animations[0].get("initialTheme") if first and member.endswith(f"/{first}.json") else None
+        skipped = []
+        if isinstance(theme, str):
+            theme_member = f"t/{theme}.json"
+            if theme_member not in names:
+                raise InputError(f"{source}: the manifest's initial theme '{theme}' is not in the archive "
+                                 f"({theme_member})")
+            rules = _parse_json(read_zip_member(archive, theme_member, source), f"{source}:{theme_member}")
+            skipped = _apply_theme(data, rules, theme, first)
+    return data, skipped
+
+
+def _apply_theme(data: dict, theme: dict, name: str, animation: str) -> list[Unsupported]:
+    """Give the animation's slots (the properties with a ``sid``) the theme's values; returns the rules skipped.
+
+    Colour, scalar, position and vector rules are applied, with a value or keyframes;
+    other types (gradient, image, text) are listed as unsupported.
+    """
+    values, skipped = {}, []
+    for index, rule in enumerate(_list(theme.get("rules"))):
+        if not isinstance(rule, dict) or not isinstance(rule.get("id"), str):
+            continue
+        if isinstance(rule.get("animations"), list) and animation not in rule["animations"]:
+            continue
+        if rule.get("type") in _THEME_RULE_TYPES and ("value" in rule or isinstance(rule.get("keyframes"), list)):
+            values[rule["id"]] = _theme_property(rule)
+        else:
+            skipped.append(Unsupported(f"theme '{name}' rules[{index}] '{rule['id']}'",
+                                       f"a rule of type {rule.get('type')}, which is not applied"))
+    data["slots"] = dict(_dict(data.get("slots"))) | {sid: {"p": value} for sid, value in values.items()}
+    return skipped
+
+
+def _inline_slots(data: dict) -> None:
+    """Put each slot's value (the file's ``slots``, a theme's) into the properties that name it, and drop ``slots``.
+
+    The player then never applies slots itself (ThorVG 1.0 crashes on a position slot).
+    """
+    slots = {sid: slot["p"] for sid, slot in _dict(data.pop("slots", None)).items()
+             if isinstance(slot, dict) and isinstance(slot.get("p"), dict)}
+    if not slots:
+        return
+    stack = [data]
+    while stack:
+        node = stack.pop()
+        children = node.values() if isinstance(node, dict) else node
+        for child in children:
+            if isinstance(child, dict) and child.get("sid") in slots:
+                value = slots[child["sid"]]
+                for key in ("a", "k"):
+                    child.pop(key, None)
+                child.update(value)
+            if isinstance(child, (dict, list)):
+                stack.append(child)
+
+
+def _theme_property(rule: dict) -> dict:
+    """A theme rule as the Lottie property its slot takes: a static value or keyframes."""
+    if "value" in rule:
+        return {"a": 0, "k": rule["value"]}
+    keyframes = []
+    for key in rule["keyframes"]:
+        value = key.get("value")
+        keyframe = {"t": key.get("frame", 0), "s": value if isinstance(value, list) else [value]}
+        if key.get("inTangent") is not None and key.get("outTangent") is not None:
+            keyframe |= {"i": key["inTangent"], "o": key["outTangent"]}
+        if key.get("hold"):
+            keyframe["h"] = 1
+        keyframes.append(keyframe)
+    return {"a": 1, "k": keyframes}
 
 
 def _embed_archive_images(data: dict, archive: zipfile.ZipFile, names: list[str], source: str) -> None:

@@ -9,6 +9,7 @@ import json
 import shutil
 import struct
 import sys
+import zipfile
 from pathlib import Path
 
 import numpy as np
@@ -175,12 +176,39 @@ def test_rendering_is_deterministic():
     assert (first[:, :, :3] <= first[:, :, 3:]).all()  # premultiplied
 
 
+def test_layers_sharing_a_name_are_one_layer(tmp_path):
+    data = json.loads((DATA / "shapes_keyframe.json").read_text())
+    data["layers"][1]["nm"] = "square"
+    (tmp_path / "anim.json").write_text(json.dumps(data))
+    document = open_document(tmp_path / "anim.json")
+    assert document.layer_names() == ["square"]
+    both = coverage(open_document(DATA / "shapes_keyframe.json"), ["square", "disc"], 0)
+    assert np.array_equal(coverage(document, ["square"], 0), both)
+
+
 # --- packed forms -----------------------------------------------------------------------------------------------
 
 def test_dotlottie_with_two_animations_shows_the_first():
     document = open_document(DATA / "two_animations.lottie")
     assert document.layer_names() == ["first square"]
     assert box(coverage(document, ["first square"], 0)) == (16, 32, 16, 32)
+
+
+def test_dotlottie_initial_theme_is_applied():
+    document = open_document(DATA / "themed.lottie")
+    rgba = ThorVGRenderer().render(document, ["square"], 0, (96, 96))
+    assert box(rgba[:, :, 3] / 255) == (64, 80, 64, 80) and tuple(rgba[72, 72]) == (230, 26, 26, 255)
+    assert [(item.element, item.message) for item in document.unsupported] == [
+        ("theme 'moved' rules[2] 'logo'", "a rule of type Image, which is not applied")]
+
+
+def test_the_files_own_slots_are_used(tmp_path):
+    """Inlined by the reader: ThorVG 1.0 crashes applying a position slot itself."""
+    with zipfile.ZipFile(DATA / "themed.lottie") as archive:
+        data = json.loads(archive.read("a/themed.json"))
+    data["slots"] = {"squarePosition": {"p": {"a": 0, "k": [40, 72]}}}
+    (tmp_path / "anim.json").write_text(json.dumps(data))
+    assert box(coverage(open_document(tmp_path / "anim.json"), ["square"], 0)) == (32, 48, 64, 80)
 
 
 def test_tgs_matches_plain_json():

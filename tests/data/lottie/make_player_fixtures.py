@@ -129,6 +129,16 @@ FIRST = animation("first", [shape_layer(1, "first square", [group("square", rect
 SECOND = animation("second", [shape_layer(1, "second square", [group("square", rect((72, 72), (16, 16)), fill())])])
 
 
+# themed.lottie (dotLottie 2 layout): a square whose position and colour are slots; its initial theme "moved"
+# sets them (and holds an image rule, which is not applied)
+THEMED = animation("themed", [shape_layer(1, "square", [group(
+    "square", {**rect((24, 24), (16, 16)), "p": {"a": 0, "k": [24, 24], "sid": "squarePosition"}},
+    {**fill(), "c": {"a": 0, "k": [0.2, 0.5, 0.8, 1], "sid": "squareColour"}})])])
+MOVED = {"rules": [{"id": "squarePosition", "type": "Position", "value": [72, 72]},
+                   {"id": "squareColour", "type": "Color", "value": [0.9, 0.1, 0.1, 1]},
+                   {"id": "logo", "type": "Image", "value": {"id": "img", "width": 8, "height": 8}}]}
+
+
 def png(width, height, rgba):
     """A PNG of one colour, written by hand so the bytes never depend on an image library's version."""
     raw = b"".join(b"\x00" + bytes(rgba) * width for _ in range(height))
@@ -150,6 +160,18 @@ def write_dotlottie(target, animations):
             archive.writestr(info, json.dumps(content, separators=(",", ":")))
 
 
+def write_dotlottie_v2(target, name, data, themes):
+    manifest = {"version": "2", "generator": "make_player_fixtures.py",
+                "animations": [{"id": name, "initialTheme": next(iter(themes))}],
+                "themes": [{"id": theme} for theme in themes]}
+    members = [("manifest.json", manifest), (f"a/{name}.json", data)] + [(f"t/{t}.json", r) for t, r in themes.items()]
+    with zipfile.ZipFile(target, "w", zipfile.ZIP_DEFLATED) as archive:
+        for member, content in members:
+            info = zipfile.ZipInfo(member, date_time=ZIP_TIME)
+            info.compress_type = zipfile.ZIP_DEFLATED
+            archive.writestr(info, json.dumps(content, separators=(",", ":")))
+
+
 def main():
     for name, data in FIXTURES.items():
         target = HERE / name
@@ -158,6 +180,7 @@ def main():
     (HERE / "image_beside" / "images").mkdir(exist_ok=True)
     (HERE / "image_beside" / "images" / "dot.png").write_bytes(png(32, 32, (200, 40, 40, 255)))
     write_dotlottie(HERE / "two_animations.lottie", [("first", FIRST), ("second", SECOND)])
+    write_dotlottie_v2(HERE / "themed.lottie", "themed", THEMED, {"moved": MOVED})
 
 
 if __name__ == "__main__":
