@@ -26,9 +26,8 @@ from fluidymation.engine.histogram import join_tables, match_histograms, quantil
 from fluidymation.engine.nnf import (
     NNF, ROTATION_FLOW, ROTATION_NONE, downscale_nnf, fill_random, merge_nnf, segment_index, upscale_nnf,
 )
-from fluidymation.engine.patchmatch import (
-    TILE_ROWS, SourceFeatures, patch_errors, patchmatch_pass, quantize_source, target_patch_cost,
-)
+from fluidymation.engine.patch_cost import SourceFeatures, patch_errors, quantize_source, target_patch_cost
+from fluidymation.engine.patchmatch import TILE_ROWS, patchmatch_pass
 from fluidymation.engine.pyramid import (
     downsample, downsample_angles, downsample_labels, gaussian_pyramid, levels_that_fit,
 )

@@ -3,6 +3,8 @@
 Before ``engine/_jit.py`` bound each compiled library to its own copies of the kernels it
 calls, a fresh process ran the callee's code and a cached one the caller's copy, which
 fastmath had reassociated differently: rotated patch costs differed in the last bits.
+And since the cached code holds those copies, a kernel's cache entry must go when a kernel it
+calls, in another file, changes.
 """
 
 import os
@@ -14,7 +16,8 @@ SCRIPT = textwrap.dedent("""
     import hashlib
     import numpy as np
     from fluidymation.engine.nnf import NNF, ROTATION_FLOW, fill_random
-    from fluidymation.engine.patchmatch import build_patch_cost, patch_errors, patchmatch_pass
+    from fluidymation.engine.patch_cost import build_patch_cost, patch_errors
+    from fluidymation.engine.patchmatch import patchmatch_pass
 
     rng = np.random.default_rng(1)
     source, target = (2, 30, 32), (20, 24)
@@ -39,9 +42,10 @@ SCRIPT = textwrap.dedent("""
 """)
 
 
-def _run(cache):
+def _run(cache, script=SCRIPT, folder=None):
     env = dict(os.environ, NUMBA_CACHE_DIR=str(cache))
-    done = subprocess.run([sys.executable, "-c", SCRIPT], env=env, capture_output=True, text=True, check=True)
+    done = subprocess.run([sys.executable, "-c", script], env=env, capture_output=True, text=True, check=True,
+                          cwd=folder)
     return done.stdout.strip()
 
 
@@ -57,3 +61,17 @@ def test_fresh_and_cached_kernels_agree_bit_for_bit(tmp_path):
     loaded = _run(cache)
     assert _cache_files(cache) == written  # ...and the second process loaded them instead of compiling
     assert loaded == compiled
+
+
+def test_editing_a_called_kernel_recompiles_its_callers(tmp_path):
+    callee = tmp_path / "callee.py"
+    callee.write_text("from fluidymation.engine._jit import kernel\n\n@kernel\ndef scale(x):\n    return x * 2.0\n")
+    (tmp_path / "caller.py").write_text(
+        "from fluidymation.engine._jit import kernel\nfrom callee import scale\n\n"
+        "@kernel\ndef run(x):\n    return scale(x) + 1.0\n"
+    )
+    script = "from caller import run; print(run(1.0))"  # run in tmp_path
+    cache = tmp_path / "numba-cache"
+    assert _run(cache, script, tmp_path) == "3.0"
+    callee.write_text(callee.read_text().replace("2.0", "3.0"))
+    assert _run(cache, script, tmp_path) == "4.0"  # not the cached caller's copy of the old scale
