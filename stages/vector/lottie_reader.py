@@ -17,13 +17,10 @@ import fnmatch
 import json
 import math
 import zipfile
-from collections.abc import Callable
 from dataclasses import dataclass
 from fractions import Fraction
 from pathlib import Path
 from typing import NamedTuple
-
-import lottie.objects
 
 from fluidymation.errors import InputError
 from fluidymation.stages.vector.base import Reader, Unsupported, VectorDocument, VectorLayer, frames_in
@@ -35,7 +32,7 @@ from fluidymation.stages.vector.safety import (
     safe_zip_member_names,
 )
 
-_PRECOMP, _NULL, _TEXT = 0, 3, 5
+_PRECOMP, _TEXT = 0, 5
 _MAX_DENOMINATOR = 10**6
 _IMAGE_TYPES = {"png": "image/png", "jpg": "image/jpeg", "jpeg": "image/jpeg", "webp": "image/webp",
                 "gif": "image/gif", "svg": "image/svg+xml"}
@@ -54,11 +51,10 @@ _CUSTOM_EFFECT = 5  # an effect group: expression controls (drawn as nothing any
 
 @dataclass(frozen=True)
 class _Unit:
-    """Where a layer lives: top-level layer ``layer``; ``child`` of that precomp or ``group`` of that shape layer."""
+    """Where a layer lives: top-level layer ``layer``, or ``child`` of that precomp."""
 
     layer: int
     child: int | None = None
-    group: int | None = None
 
 
 class PlayerFrame(NamedTuple):
@@ -69,23 +65,14 @@ class PlayerFrame(NamedTuple):
     frame: float
 
 
-class LottieFrame(NamedTuple):
-    """Layers of an imported SMIL SVG isolated for ``lottie-svg``: the lottie package's animation and its frame."""
-
-    animation: lottie.objects.Animation
-    frame: float
-
-
 class LottieDocument(VectorDocument):
     """A Lottie animation (``data``, its JSON) whose layers can be drawn alone.
 
-    ``files`` are the file itself and the image files beside it that it uses. With
-    ``groups_as_layers`` the groups of top-level shape layers are the layers (an imported
-    SMIL SVG, drawn by ``lottie-svg``).
+    ``files`` are the file itself and the image files beside it that it uses.
     """
 
     def __init__(self, path: Path, data: dict, *, kind: str, reader: Reader, split: tuple[str, ...] = (),
-                 native_fps: float | None = None, groups_as_layers: bool = False, images: tuple[Path, ...] = (),
+                 native_fps: float | None = None, images: tuple[Path, ...] = (),
                  unsupported: tuple[Unsupported, ...] = ()):
         self.path = path
         self.kind = kind
@@ -97,11 +84,10 @@ class LottieDocument(VectorDocument):
         self.lottie_fps = float(data["fr"])
         self.native_fps = native_fps
         self.in_point, self.out_point = float(data["ip"]), float(data["op"])
-        self._groups_as_layers = groups_as_layers
-        self._units = _units(data, split, groups_as_layers)
+        self._units = _units(data, split)
         names_bottom_up = list(reversed(list(self._units)))
         self.layers = [VectorLayer(name, z) for z, name in enumerate(names_bottom_up)]
-        self._isolated: dict[tuple[str, ...], bytes | lottie.objects.Animation] = {}
+        self._isolated: dict[tuple[str, ...], bytes] = {}
 
     def frame_range(self, fps: float) -> tuple[int, int]:
         start = math.floor(self.in_point * fps / self.lottie_fps + 1e-6)
@@ -120,16 +106,11 @@ class LottieDocument(VectorDocument):
         time = Fraction(time_seconds).limit_denominator(_MAX_DENOMINATOR)
         return float(time * Fraction(self.lottie_fps))
 
-    def isolate(self, names, time_seconds) -> PlayerFrame | LottieFrame:
-        """A :class:`PlayerFrame`; for an imported SMIL SVG a :class:`LottieFrame` (lottie-svg draws those)."""
+    def isolate(self, names, time_seconds) -> PlayerFrame:
         key = tuple(sorted(names))
         if key not in self._isolated:
-            isolated = _isolate(self.data, [unit for name in key for unit in self._units[name]],
-                                silence=_as_null if self._groups_as_layers else _hidden)
-            self._isolated[key] = (_load_animation(isolated, str(self.path)) if self._groups_as_layers
-                                   else json.dumps(isolated, separators=(",", ":")).encode())
-        if self._groups_as_layers:
-            return LottieFrame(self._isolated[key], self.lottie_frame(time_seconds))
+            isolated = _isolate(self.data, [unit for name in key for unit in self._units[name]])
+            self._isolated[key] = json.dumps(isolated, separators=(",", ":")).encode()
         return PlayerFrame(self._isolated[key], self.lottie_frame(time_seconds) - self.in_point)
 
 
@@ -341,14 +322,7 @@ def _check_layers(layers, where: str, source: str) -> None:
             raise InputError(f"{source}: {where}[{index}] is not a Lottie layer (needs an integer 'ty')")
 
 
-def _load_animation(data: dict, source: str) -> lottie.objects.Animation:
-    try:
-        return lottie.objects.Animation.load(data)
-    except Exception as exc:  # the lottie loader raises many types on malformed input
-        raise InputError(f"{source}: not a valid Lottie animation ({type(exc).__name__}: {exc})") from None
-
-
-def _units(data: dict, split: tuple[str, ...], groups_as_layers: bool) -> dict[str, list[_Unit]]:
+def _units(data: dict, split: tuple[str, ...]) -> dict[str, list[_Unit]]:
     """Layer name -> where its layers live, top of the stack first (Lottie order).
 
     Layers that share a name are one layer of the document (a user cannot tell them apart).
@@ -357,12 +331,6 @@ def _units(data: dict, split: tuple[str, ...], groups_as_layers: bool) -> dict[s
     precomps = {asset.get("id"): asset for asset in data.get("assets") or [] if "layers" in asset}
     for index, layer in enumerate(data["layers"]):
         name = str(layer.get("nm") or f"layer {index}")
-        if groups_as_layers and layer["ty"] == 4:
-            for group_index, shape in enumerate(layer.get("shapes") or []):
-                if shape.get("ty") == "gr":
-                    units.setdefault(str(shape.get("nm") or f"group {group_index}"), []).append(
-                        _Unit(index, group=group_index))
-            continue
         if layer["ty"] == _PRECOMP and any(fnmatch.fnmatchcase(name, pattern) for pattern in split):
             children = precomps.get(layer.get("refId"), {}).get("layers") or []
             for child_index, child in enumerate(children):
@@ -373,38 +341,33 @@ def _units(data: dict, split: tuple[str, ...], groups_as_layers: bool) -> dict[s
     return units
 
 
-def _isolate(data: dict, keep: list[_Unit], *, silence: Callable[[dict], dict]) -> dict:
-    """A copy of ``data`` in which only the ``keep`` units draw; ``silence`` makes a layer that must not draw.
+def _isolate(data: dict, keep: list[_Unit]) -> dict:
+    """A copy of ``data`` in which only the ``keep`` units draw: every other layer is hidden.
 
     Kept layers keep their track-matte sources (which are never drawn themselves). Only
     what changes is copied: the rest is shared with ``data``, which is never modified.
     """
     layers = data["layers"]
-    whole = {unit.layer for unit in keep if unit.child is None and unit.group is None}
+    whole = {unit.layer for unit in keep if unit.child is None}
     partial = {unit.layer for unit in keep} - whole
     needed = _with_matte_sources(layers, whole | partial)
-    isolated = dict(data, layers=[layer if index in needed else silence(layer) for index, layer in enumerate(layers)],
+    isolated = dict(data, layers=[layer if index in needed else _hidden(layer) for index, layer in enumerate(layers)],
                     assets=list(data.get("assets") or []))
     for index in sorted(partial):
-        isolated["layers"][index] = _keep_parts(isolated, layers[index], [u for u in keep if u.layer == index],
-                                                index, silence)
+        isolated["layers"][index] = _keep_children(isolated, layers[index], {u.child for u in keep if u.layer == index},
+                                                   index)
     return isolated
 
 
-def _keep_parts(isolated: dict, layer: dict, keep: list[_Unit], index: int, silence: Callable[[dict], dict]) -> dict:
-    """``layer`` drawing only the kept groups (an imported SMIL SVG) or the kept children of its precomp (``split``).
+def _keep_children(isolated: dict, layer: dict, children: set[int], index: int) -> dict:
+    """The precomp ``layer`` drawing only its ``children`` (``split``), isolated in a private copy of the precomp.
 
-    The children are isolated in a private copy of the precomp, added to ``isolated``'s assets.
+    The copy is added to ``isolated``'s assets.
     """
-    groups = {unit.group for unit in keep if unit.group is not None}
-    if groups:
-        return dict(layer, shapes=[shape for i, shape in enumerate(layer.get("shapes") or [])
-                                   if i in groups or shape.get("ty") != "gr"])
     asset = next(a for a in isolated["assets"] if a.get("id") == layer.get("refId"))
-    children = asset["layers"]
-    kept = _with_matte_sources(children, {unit.child for unit in keep})
+    kept = _with_matte_sources(asset["layers"], children)
     private = dict(asset, id=f"{asset['id']}::isolated{index}",
-                   layers=[child if i in kept else silence(child) for i, child in enumerate(children)])
+                   layers=[child if i in kept else _hidden(child) for i, child in enumerate(asset["layers"])])
     isolated["assets"].append(private)
     return dict(layer, refId=private["id"])
 
@@ -432,13 +395,6 @@ def _with_matte_sources(layers: list[dict], indices: set[int]) -> set[int]:
 def _hidden(layer: dict) -> dict:
     """``layer`` marked hidden: players draw nothing of it, but it still parents others and expressions find it."""
     return dict(layer, hd=True)
-
-
-def _as_null(layer: dict) -> dict:
-    """A null layer that keeps ``layer``'s index, parent, timing and transform (the lottie package hides the
-    children of a hidden layer, so lottie-svg needs this instead of :func:`_hidden`)."""
-    kept = {key: layer[key] for key in ("ind", "parent", "ks", "ip", "op", "st", "sr", "nm") if key in layer}
-    return kept | {"ty": _NULL, "ddd": 0}
 
 
 def _unsupported(data: dict) -> list[Unsupported]:

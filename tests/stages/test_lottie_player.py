@@ -291,7 +291,8 @@ def test_check_warns_and_strict_refuses(cli, tmp_path):
 
 def faulty_worker(render_body: str) -> tuple[str, ...]:
     """The real worker (its setup and protocol) with ``Player.render`` replaced by ``render_body``."""
-    code = (f"import os, resource, signal, struct, sys, time; sys.path.insert(0, {str(Path(thorvg_worker.__file__).parent)!r}); "
+    folder = str(Path(thorvg_worker.__file__).parent)
+    code = (f"import os, resource, signal, struct, sys, time; sys.path.insert(0, {folder!r}); "
             f"import thorvg_worker as w; w.Player.render = lambda self, key, frame, width, height: {render_body}; "
             "w.main()")
     return (sys.executable, "-c", code)
