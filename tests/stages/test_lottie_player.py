@@ -6,6 +6,7 @@ checked instead (tests/data/lottie/README.md gives each fixture's numbers).
 """
 
 import json
+import pickle
 import shutil
 import struct
 import sys
@@ -166,6 +167,15 @@ def test_a_worker_keeps_few_animations_and_forgets_the_oldest(monkeypatch):
     again = [renderer.render(document, [name], 0.4, (96, 96)) for name in ("head", "torso")]
     assert all(np.array_equal(a, b) for a, b in zip(first, again))
     assert list(renderer._workers[document].loaded) == [("torso",)]
+
+
+def test_a_copied_renderer_starts_its_own_worker():
+    """Plans are pickled to spawned jobs: the copy leaves the worker behind and starts one of its own."""
+    renderer, document = ThorVGRenderer(frame_timeout=5), open_document(DATA / "parenting.json")
+    here = renderer.render(document, ["head"], 0.4, (96, 96))
+    copy = pickle.loads(pickle.dumps(renderer))
+    assert copy.frame_timeout == 5 and not copy._workers
+    assert np.array_equal(copy.render(document, ["head"], 0.4, (96, 96)), here)
 
 
 def test_rendering_is_deterministic():
