@@ -27,8 +27,8 @@ from fluidymation.stages.vector.safety import XLINK_HREF, is_internal_reference,
 from fluidymation.stages.vector.smil_path import MotionPath, PathData
 from fluidymation.stages.vector.smil_timing import (INDEFINITE, Condition, Interval, Timeline, TimelineError, Timing,
                                                     clock_value, parse_conditions)
-from fluidymation.stages.vector.smil_values import (STRING, TRANSFORM_PARAMETERS, PointType, TransformType,
-                                                    ValueType, value_type_for)
+from fluidymation.stages.vector.smil_values import (TRANSFORM_PARAMETERS, PointType, TransformType, ValueType,
+                                                    value_type_for)
 from fluidymation.stages.vector.svg_reader import Animation, set_style_property, style_property
 
 ANIMATION_TAGS = ("animate", "set", "animateColor", "animateTransform", "animateMotion")
@@ -317,27 +317,29 @@ class SmilAnimation(Animation):
         """When the last animation's last active interval ends.
 
         An animation that repeats forever (``repeatCount="indefinite"``, no end) counts until
-        the end of its first simple duration, and one that keeps restarting through syncbases
-        (``begin="0;last.end"``) until its second begin: one cycle.
+        the end of its first simple duration. Animations that keep restarting through
+        syncbases (``begin="0;last.end"``) count one cycle: from the first begin among them,
+        the longest time between two begins of one of them.
         """
         for level in range(_MAX_HORIZON_DOUBLINGS + 1):
             horizon = _HORIZON_BLOCK * 2 ** level
             timeline = self.timeline(horizon / 2)
-            ends = [_played_until(intervals, timing, horizon) for intervals, timing in
-                    zip(timeline.intervals, self.timings) if intervals]
-            latest = max(ends, default=0.0)
-            if latest < horizon / 2:
-                return latest
-        return latest
-
-
-def _played_until(intervals: list[Interval], timing: Timing, horizon: float) -> float:
-    first, last = intervals[0], intervals[-1]
-    if last.end == INDEFINITE:
-        return max(0.0, first.begin + (timing.dur if timing.dur != INDEFINITE else 0.0))
-    if last.begin >= horizon / 2:
-        return intervals[1].begin if len(intervals) > 1 else first.end
-    return last.end
+            ends, cycles, undecided = [0.0], [], False
+            for intervals, timing, continues in zip(timeline.intervals, self.timings, timeline.continues):
+                if intervals and intervals[-1].end == INDEFINITE:
+                    ends.append(intervals[0].begin + (timing.dur if timing.dur != INDEFINITE else 0.0))
+                elif continues and len(intervals) >= 2:
+                    cycles.append((intervals[0].begin, intervals[1].begin - intervals[0].begin))
+                elif continues:
+                    undecided = True  # it begins (again) beyond this horizon
+                elif intervals:
+                    ends.append(intervals[-1].end)
+            if cycles:
+                ends.append(min(start for start, _ in cycles) + max(period for _, period in cycles))
+            latest = max(ends)
+            if not undecided and latest < horizon / 2:
+                return max(latest, 0.0)
+        return max(latest, 0.0)
 
 
 def _position(timeline: Timeline, timing: Timing, animated: Animated, time_seconds: float):
@@ -530,7 +532,7 @@ def _function(element, target, by_id, parents, report) -> tuple[str, bool, Funct
 
 
 def _base_value(target, name, parents) -> str:
-    """The attribute's own value: the style's, the presentation attribute's, the parent's (if inherited), the initial."""
+    """The attribute's own value: from the style, the attribute, the parent (if inherited), or the initial value."""
     element = target
     while element is not None:
         if name in PROPERTIES:

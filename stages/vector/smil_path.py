@@ -29,7 +29,7 @@ class PathData:
     @classmethod
     def parse(cls, text: str) -> PathData:
         """Parse ``d`` text; a ValueError names what is wrong."""
-        commands, position, letter = [], 0, None
+        commands, position, letter, waiting = [], 0, None, False  # waiting: a command letter without its numbers
         text = text.strip()
         while position < len(text):
             match = _TOKEN.match(text, position)
@@ -37,8 +37,10 @@ class PathData:
                 raise ValueError(f"path data has '{text[position:position + 10]}' where a command or number belongs")
             token = match.group(1)
             if token.isalpha():
-                letter, position = token, match.end()
-                if letter in "zZ":
+                if waiting:
+                    raise ValueError(f"the '{letter}' command has no numbers")
+                letter, position, waiting = token, match.end(), token not in "zZ"
+                if not waiting:
                     commands.append((letter, ()))
                     letter = None
                 continue
@@ -46,8 +48,11 @@ class PathData:
                 raise ValueError("path data must begin with a moveto and numbers must follow a command")
             arguments, position = _arguments(text, position, letter)
             commands.append((letter, arguments))
+            waiting = False
             if letter in "mM":
                 letter = "l" if letter == "m" else "L"  # coordinates after a moveto are lineto's
+        if waiting:
+            raise ValueError(f"the '{letter}' command has no numbers")
         if commands and commands[0][0] not in "mM":
             raise ValueError("path data must begin with a moveto")
         return cls(tuple(commands))
@@ -206,7 +211,8 @@ def _cubic(p0, p1, p2, p3) -> list[tuple[float, float, float, float]]:
     return points
 
 
-def _arc(start, rx: float, ry: float, angle: float, large: bool, sweep: bool, end) -> list[tuple[float, float, float, float]]:
+def _arc(start, rx: float, ry: float, angle: float, large: bool, sweep: bool,
+         end) -> list[tuple[float, float, float, float]]:
     """An elliptical arc as a polyline (SVG 1.1 appendix F.6: endpoint to centre parameterization)."""
     rx, ry = abs(rx), abs(ry)
     if start == end or rx == 0 or ry == 0:

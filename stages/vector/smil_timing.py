@@ -15,7 +15,9 @@ from __future__ import annotations
 import bisect
 import math
 import re
+from collections import deque
 from dataclasses import dataclass
+from operator import attrgetter, itemgetter
 
 INDEFINITE = math.inf
 #: Recomputations of one element's intervals, per interval kept, before the timeline is said not to settle.
@@ -27,6 +29,10 @@ _METRIC = {"h": 3600.0, "min": 60.0, "s": 1.0, "ms": 0.001, None: 1.0}
 _OFFSET = re.compile(r"^([+-])?\s*(.*)$")
 _SYNCBASE = re.compile(r"^((?:[^.\\\s]|\\.)+)\.(begin|end)\s*(?:([+-])\s*(.+))?$")
 _REPEAT = re.compile(r"^(?:((?:[^.\\\s]|\\.)+)\.)?repeat\((\d+)\)\s*(?:([+-])\s*(.+))?$")
+_TIME = itemgetter(0)
+_END = attrgetter("end")
+#: The source recorded for an instance time given as an offset (sorts before any element's index).
+_OFFSET_SOURCE = -1
 _EVENT = re.compile(r"^(?:((?:[^.\\\s]|\\.)+)\.)?([A-Za-z][\w-]*)\s*(?:([+-])\s*(.+))?$")
 
 
@@ -104,9 +110,9 @@ def _condition(entry: str) -> Condition | None:
     return None
 
 
-def _arcs(conditions: tuple[Condition, ...], ids: dict[str, int]) -> list[tuple[Condition, int]]:
-    """The syncbase and repeat conditions among ``conditions`` that name a timed element, with its index."""
-    return [(c, ids[c.base]) for c in conditions if c.kind in ("syncbase", "repeat") and c.base in ids]
+def _is_arc(condition: Condition, ids: dict[str, int]) -> bool:
+    """Whether the condition is a syncbase or repeat condition naming a timed element."""
+    return condition.kind in ("syncbase", "repeat") and condition.base in ids
 
 
 def _signed_clock(entry: str) -> float | None:
@@ -182,79 +188,129 @@ class Timeline:
     ``timings`` are in document order (an element's index is its priority among equal
     begins); ``ids`` maps element ids to indices, for syncbases. Intervals that begin at
     or after the horizon are not computed; the timeline is exact before it.
+
+    Resolution is a worklist over elements: when an element's intervals change, the instance
+    times its dependents derive from them are updated, and each dependent recomputes only its
+    intervals from the earliest instance time that moved (those ending before it stay).
     """
 
     def __init__(self, timings: list[Timing], ids: dict[str, int], horizon: float):
         self.timings = timings
         self.horizon = horizon
         self.intervals: list[list[Interval]] = [[] for _ in timings]
-        self._static_begins = [sorted(c.offset for c in t.begins if c.kind == "offset") for t in timings]
-        self._static_ends = [sorted(c.offset for c in t.ends if c.kind == "offset") for t in timings]
-        self._begin_arcs = [_arcs(t.begins, ids) for t in timings]
-        self._end_arcs = [_arcs(t.ends, ids) for t in timings]
-        self._dependents: list[list[int]] = [[] for _ in timings]
-        for index in range(len(timings)):
-            for _, base in (*self._begin_arcs[index], *self._end_arcs[index]):
-                if index not in self._dependents[base]:
-                    self._dependents[base].append(index)
+        self._truncated = [False] * len(timings)  # it begins again at or after the horizon
+        self._static_begins = [[(c.offset, _OFFSET_SOURCE) for c in t.begins if c.kind == "offset"] for t in timings]
+        self._static_ends = [[(c.offset, _OFFSET_SOURCE) for c in t.ends if c.kind == "offset"] for t in timings]
+        # Syncbase and repeat conditions: (is a begin condition, condition, base index); per arc, the instance
+        # time each of the base's intervals gives (or None), in the order of the base's intervals.
+        self._arcs = [[(True, c, ids[c.base]) for c in t.begins if _is_arc(c, ids)] +
+                      [(False, c, ids[c.base]) for c in t.ends if _is_arc(c, ids)] for t in timings]
+        self._derived: list[list[list]] = [[[] for _ in arcs] for arcs in self._arcs]
+        self._dependents: list[list[tuple[int, int]]] = [[] for _ in timings]
+        for index, arcs in enumerate(self._arcs):
+            for slot, (_, _, base) in enumerate(arcs):
+                self._dependents[base].append((index, slot))
         self._resolve()
         self._begins = [[interval.begin for interval in intervals] for intervals in self.intervals]
+        #: Whether an element's intervals go on past the horizon: it begins again at or after it, or it still
+        #: began in the horizon's second half following (through syncbases) an element that goes on.
+        self.continues = list(self._truncated)
+        spreading = True
+        while spreading:
+            spreading = False
+            for index, arcs in enumerate(self._arcs):
+                if (not self.continues[index] and self.intervals[index] and
+                        self.intervals[index][-1].begin >= horizon / 2 and
+                        any(self.continues[base] for _, _, base in arcs)):
+                    self.continues[index] = spreading = True
 
     def _resolve(self) -> None:
-        pending = list(range(len(self.timings)))
-        queued = set(pending)
-        rounds = [0] * len(self.timings)
+        count = len(self.timings)
+        pending, queued = deque(range(count)), set(range(count))
+        since = [-INDEFINITE] * count  # per element: the earliest instance time that may have moved
+        rounds = [0] * count
         while pending:
-            index = pending.pop(0)
+            index = pending.popleft()
             queued.discard(index)
             rounds[index] += 1
             if rounds[index] > _MAX_ROUNDS_PER_INTERVAL * (len(self.intervals[index]) + 2):
                 raise TimelineError(index)
-            intervals = self._intervals(index)
-            if intervals == self.intervals[index]:
+            old = self.intervals[index]
+            new, kept, self._truncated[index] = self._intervals(index, since[index])
+            since[index] = INDEFINITE
+            first = next((kept + k for k, (a, b) in enumerate(zip(old[kept:], new[kept:])) if a != b),
+                         min(len(old), len(new)))
+            if first == len(old) == len(new):
                 continue
-            self.intervals[index] = intervals
-            for dependent in self._dependents[index]:
-                if dependent not in queued:
-                    pending.append(dependent)
-                    queued.add(dependent)
+            self.intervals[index] = new
+            for dependent, slot in self._dependents[index]:
+                moved = self._derive(dependent, slot, old, new, first)
+                if moved < since[dependent]:
+                    since[dependent] = moved
+                    if dependent not in queued:
+                        pending.append(dependent)
+                        queued.add(dependent)
 
-    def _instances(self, arcs: list[tuple[Condition, int]], static: list[float]) -> list[tuple[float, int | None]]:
-        """Instance times now: the static offsets and what the syncbases' (``arcs``) intervals give."""
-        times = [(t, None) for t in static]
-        for condition, base in arcs:
-            for interval in self.intervals[base]:
-                if condition.kind == "syncbase":
-                    edge = interval.begin if condition.edge == "begin" else interval.end
-                    if edge != INDEFINITE:
-                        times.append((edge + condition.offset, base))
-                else:
-                    simple = self.timings[base].dur
-                    start = interval.begin + condition.count * simple
-                    if condition.count > 0 and start < interval.end and simple != INDEFINITE:
-                        times.append((start + condition.offset, base))
-        times.sort(key=lambda item: (item[0], -1 if item[1] is None else item[1]))
+    def _derive(self, index: int, slot: int, old: list[Interval], new: list[Interval], first: int) -> float:
+        """Update arc ``slot`` of element ``index`` from its base's intervals (changed from ``first`` on).
+
+        Returns the earliest instance time that moved, or INDEFINITE when none did.
+        """
+        _, condition, base = self._arcs[index][slot]
+        before = [self._instance(condition, base, interval) for interval in old[first:]]
+        after = [self._instance(condition, base, interval) for interval in new[first:]]
+        self._derived[index][slot][first:] = after
+        moved = [time for time, _ in filter(None, before + after)]
+        return min(moved, default=INDEFINITE) if before != after else INDEFINITE
+
+    def _instance(self, condition: Condition, base: int, interval: Interval) -> tuple[float, int] | None:
+        """The instance time a base interval gives through ``condition``, with the base's index, if any."""
+        if condition.kind == "syncbase":
+            edge = interval.begin if condition.edge == "begin" else interval.end
+            return None if edge == INDEFINITE else (edge + condition.offset, base)
+        simple = self.timings[base].dur
+        start = interval.begin + condition.count * simple
+        if condition.count > 0 and simple != INDEFINITE and start < interval.end:
+            return start + condition.offset, base
+        return None
+
+    def _instances(self, index: int, begins: bool) -> list[tuple[float, int]]:
+        """The element's begin (or end) instance times now, sorted, each with the element that gave it (or -1)."""
+        times = list(self._static_begins[index] if begins else self._static_ends[index])
+        for (is_begin, _, _), derived in zip(self._arcs[index], self._derived[index]):
+            if is_begin == begins:
+                times.extend(filter(None, derived))
+        times.sort()
         return times
 
-    def _intervals(self, index: int) -> list[Interval]:
+    def _intervals(self, index: int, since: float) -> tuple[list[Interval], int, bool]:
+        """The element's intervals, keeping those that end before ``since``.
+
+        Returns them, how many were kept, and whether the element begins again past the horizon.
+        """
         timing = self.timings[index]
-        begins = self._instances(self._begin_arcs[index], self._static_begins[index])
-        ends = [t for t, _ in self._instances(self._end_arcs[index], self._static_ends[index])]
-        begin_times = [t for t, _ in begins]
-        intervals: list[Interval] = []
-        begin_after = -INDEFINITE
-        after_zero = False
+        begins = self._instances(index, True)
+        ends = self._instances(index, False)
+        kept = bisect.bisect_left(self.intervals[index], since, key=_END)
+        intervals = self.intervals[index][:kept]
+        if intervals and (timing.restart == "never" or intervals[-1].end == INDEFINITE):
+            return intervals, kept, False
+        begin_after = intervals[-1].end if intervals else -INDEFINITE
+        after_zero = bool(intervals) and intervals[-1].end == intervals[-1].begin
         while True:
-            position = (bisect.bisect_right if after_zero else bisect.bisect_left)(begin_times, begin_after)
-            if position == len(begins) or begins[position][0] >= self.horizon:
+            find = bisect.bisect_right if after_zero else bisect.bisect_left
+            position = find(begins, begin_after, key=_TIME)
+            if position == len(begins):
                 break
             begin, source = begins[position]
+            if begin >= self.horizon:
+                return intervals, kept, True
             if timing.has_end:
-                end_at = bisect.bisect_left(ends, begin)
-                if end_at < len(ends) and ends[end_at] == begin and intervals and after_zero:
+                end_at = bisect.bisect_left(ends, begin, key=_TIME)
+                if end_at < len(ends) and ends[end_at][0] == begin and intervals and after_zero:
                     end_at += 1
                 if end_at < len(ends):
-                    end = begin + timing.active_duration(begin, ends[end_at])
+                    end = begin + timing.active_duration(begin, ends[end_at][0])
                 elif timing.end_is_open() or not ends:
                     end = begin + timing.active_duration(begin, None)
                 else:
@@ -262,17 +318,17 @@ class Timeline:
             else:
                 end = begin + timing.active_duration(begin, None)
             if timing.restart == "always":
-                later = bisect.bisect_right(begin_times, begin)
-                if later < len(begin_times) and begin_times[later] < end:
-                    end = begin_times[later]
+                later = bisect.bisect_right(begins, begin, key=_TIME)
+                if later < len(begins) and begins[later][0] < end:
+                    end = begins[later][0]
             if not intervals and not (end > 0 or begin == end == 0):
                 begin_after, after_zero = end, False
                 continue
-            intervals.append(Interval(begin, end, source))
+            intervals.append(Interval(begin, end, None if source == _OFFSET_SOURCE else source))
             if timing.restart == "never" or end == INDEFINITE:
                 break
             begin_after, after_zero = end, end == begin
-        return intervals
+        return intervals, kept, False
 
     def state(self, index: int, time: float) -> tuple[Interval, bool] | None:
         """The interval that shows at ``time`` and whether it is active (else it is over: frozen or removed)."""

@@ -113,6 +113,20 @@ def test_svg_layers_are_top_level_groups_by_label_then_id(tmp_path):
     assert coverage(document, ["Left", "right"], 0).sum() == pytest.approx(800)  # the background rect is no layer
 
 
+def test_svg_without_groups_has_a_layer_per_top_level_element(tmp_path):
+    path = tmp_path / "loose.svg"
+    path.write_text('<svg xmlns="http://www.w3.org/2000/svg" width="40" height="10"><title>loose</title>'
+                    '<defs><rect id="unused" width="40" height="10"/></defs><rect id="left" width="10" height="10"/>'
+                    '<circle cx="15" cy="5" r="5"/><circle cx="25" cy="5" r="5"/>'
+                    '<path d="M30,0 h10 v10 h-10 z"/></svg>')
+    document = open_document(path)
+    assert document.layer_names() == ["left", "circle 1", "circle 2", "path 3"]
+    alone = coverage(document, ["circle 2"], 0)
+    assert alone[:, 20:30].sum() == pytest.approx(np.pi * 25, rel=0.05)
+    assert alone[:, :20].sum() == alone[:, 30:].sum() == 0
+    assert coverage(document, document.layer_names(), 0).sum() == pytest.approx(200 + 2 * np.pi * 25, rel=0.02)
+
+
 def test_svg_sequence_in_numeric_order(tmp_path):
     for index in (0, 1, 2, 10):
         (tmp_path / f"f{index}.svg").write_text(
