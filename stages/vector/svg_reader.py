@@ -35,6 +35,8 @@ SVG_NAMESPACE = "http://www.w3.org/2000/svg"
 MAX_SEQUENCE_FILES = 100_000
 _DRAWN = {"g", "path", "rect", "circle", "ellipse", "line", "polyline", "polygon", "text", "use", "image", "svg",
           "switch", "a", "foreignObject"}
+#: The filter primitives cairosvg applies (feBlend: its mode only); it leaves out every other one.
+_DRAWN_FILTER_PRIMITIVES = {"feOffset", "feFlood", "feBlend"}
 _UNITS_PX = {"": 1.0, "px": 1.0, "pt": 96 / 72, "pc": 16.0, "mm": 96 / 25.4, "cm": 96 / 2.54, "in": 96.0}
 _LENGTH = re.compile(r"^\s*([0-9.eE+-]+)\s*([a-z%]*)\s*$")
 
@@ -76,6 +78,21 @@ def _number(text: str) -> float | None:
         return float(text)
     except ValueError:
         return None
+
+
+def undrawn(root: ElementTree.Element) -> tuple[Unsupported, ...]:
+    """What the file holds that cairosvg does not draw: filter primitives other than feOffset, feFlood, feBlend."""
+    items = []
+    for element in root.iter():
+        if local_name(element.tag) != "filter":
+            continue
+        left_out = sorted({local_name(child.tag) for child in element if local_name(child.tag).startswith("fe")}
+                          - _DRAWN_FILTER_PRIMITIVES)
+        if left_out:
+            label = f'<filter id="{element.get("id")}">' if element.get("id") else "<filter>"
+            items.append(Unsupported(label, f"cairosvg does not draw {', '.join(f'<{tag}>' for tag in left_out)}: "
+                                            "what the filter applies to is drawn without them"))
+    return tuple(items)
 
 
 def _top_layers(root: ElementTree.Element) -> list[tuple[ElementTree.Element, str]]:
@@ -174,7 +191,8 @@ class SvgDocument(VectorDocument):
         self.width, self.height = svg_size(root, str(path))
         self.layers = [VectorLayer(name, z) for z, name in enumerate(_layer_names(root))]
         self.animations = tuple(animation for parse in ANIMATIONS if (animation := parse(root, str(path))))
-        self.unsupported = tuple(item for animation in self.animations for item in animation.unsupported)
+        self.unsupported = undrawn(root) + tuple(item for animation in self.animations
+                                                 for item in animation.unsupported)
 
     def frame_range(self, fps):
         if not self.animations:
@@ -190,7 +208,7 @@ class SvgDocument(VectorDocument):
 
 
 class SvgSequenceDocument(VectorDocument):
-    """Numbered SVG files, one per frame at ``fps``; layers are those of the first file."""
+    """Numbered SVG files, one per frame at ``fps``; layers (and what is not drawn) are those of the first file."""
 
     kind = "svg-sequence"
     native_fps = None
@@ -203,6 +221,7 @@ class SvgSequenceDocument(VectorDocument):
         first = load_svg(files[0])
         self.width, self.height = svg_size(first, str(files[0]))
         self.layers = [VectorLayer(name, z) for z, name in enumerate(_layer_names(first))]
+        self.unsupported = undrawn(first)
 
     def frame_range(self, fps):
         return 0, len(self.files)

@@ -127,6 +127,17 @@ def test_svg_without_groups_has_a_layer_per_top_level_element(tmp_path):
     assert coverage(document, document.layer_names(), 0).sum() == pytest.approx(200 + 2 * np.pi * 25, rel=0.02)
 
 
+def test_svg_filter_primitives_cairosvg_leaves_out_are_reported(tmp_path):
+    path = tmp_path / "soft.svg"
+    path.write_text('<svg xmlns="http://www.w3.org/2000/svg" width="10" height="10"><filter id="soft">'
+                    '<feGaussianBlur stdDeviation="2"/><feColorMatrix values="1 0 0 0 0"/><feOffset dx="1"/></filter>'
+                    '<filter id="shift"><feOffset dx="1"/></filter>'
+                    '<rect width="5" height="5" filter="url(#soft)"/></svg>')
+    assert [(item.element, item.message) for item in open_document(path).unsupported] == [
+        ('<filter id="soft">', "cairosvg does not draw <feColorMatrix>, <feGaussianBlur>: what the filter applies to "
+                               "is drawn without them")]
+
+
 def test_svg_sequence_in_numeric_order(tmp_path):
     for index in (0, 1, 2, 10):
         (tmp_path / f"f{index}.svg").write_text(
