@@ -9,6 +9,7 @@ naming the file and the frame; the next render starts a new one.
 
 from __future__ import annotations
 
+import mmap
 import os
 import select
 import signal
@@ -29,6 +30,7 @@ from fluidymation.stages.vector.base import Renderer
 
 WORKER_SCRIPT = Path(protocol.__file__)
 LOADED_PER_WORKER = 8  # isolated animations a worker keeps (a layer's frames are rendered one after the other)
+SHARED_FOLDER = "/dev/shm" if os.path.isdir("/dev/shm") and os.access("/dev/shm", os.W_OK) else None
 
 
 class PlayerFailed(Exception):
@@ -72,22 +74,28 @@ class ThorVGRenderer(Renderer):
             worker = self._workers[document] = _Worker(self.command)
         try:
             key = worker.load(tuple(sorted(layers)), isolated.json, self.load_timeout)
-            rgba = worker.render(key, isolated.frame, width, height, self.frame_timeout)
+            return worker.render(key, isolated.frame, width, height, self.frame_timeout)
         except PlayerFailed as exc:
             frame = f"frame {isolated.frame + document.in_point:g} ({time_seconds:.3f} s)"
             raise InputError(f"{document.path}: {frame}: {exc.reason}") from None
-        return np.frombuffer(rgba, np.uint8).reshape(height, width, 4).copy()
 
 
 class _Worker:
-    """One ThorVG child process and the isolated animations it has loaded (least recently used first)."""
+    """One ThorVG child process and the isolated animations it has loaded (least recently used first).
+
+    Frames come back through a shared file (in memory where /dev/shm exists), not the pipe.
+    """
 
     def __init__(self, command: tuple[str, ...]):
         self.errors = tempfile.TemporaryFile()
-        self.process = subprocess.Popen(command, stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=self.errors)
+        self.shared = tempfile.TemporaryFile(dir=SHARED_FOLDER)
+        self.view: mmap.mmap | None = None
+        descriptor = self.shared.fileno()
+        self.process = subprocess.Popen((*command, str(descriptor)), stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                                        stderr=self.errors, pass_fds=(descriptor,))
         self.loaded: OrderedDict[tuple[str, ...], int] = OrderedDict()
         self.next_key = 0
-        weakref.finalize(self, _stop, self.process, self.errors)
+        weakref.finalize(self, _stop, self.process, self.errors, self.shared)
 
     def alive(self) -> bool:
         return self.process.poll() is None
@@ -105,11 +113,19 @@ class _Worker:
         self.loaded[names] = key
         return key
 
-    def render(self, key: int, frame: float, width: int, height: int, timeout: float) -> bytes:
-        rgba = self._ask(b"R", struct.pack(protocol.RENDER, key, frame, width, height), timeout, "drawing")
-        if len(rgba) != width * height * 4:
-            raise PlayerFailed(f"the Lottie player returned {len(rgba)} bytes for a {width}x{height} frame")
-        return rgba
+    def render(self, key: int, frame: float, width: int, height: int, timeout: float) -> np.ndarray:
+        """(height, width, 4) uint8 premultiplied RGBA."""
+        size = width * height * 4
+        if self.view is None or len(self.view) < size:
+            if self.view is not None:
+                self.view.close()
+            os.ftruncate(self.shared.fileno(), size)
+            self.view = mmap.mmap(self.shared.fileno(), size)
+        reply = self._ask(b"R", struct.pack(protocol.RENDER, key, frame, width, height), timeout, "drawing")
+        (count,) = struct.unpack(protocol.COUNT, reply)
+        if count != size:
+            raise PlayerFailed(f"the Lottie player returned {count} bytes for a {width}x{height} frame")
+        return np.frombuffer(self.view, np.uint8, count=size).reshape(height, width, 4).copy()
 
     def _ask(self, kind: bytes, payload: bytes, timeout: float, doing: str) -> bytes:
         """Send one request and wait up to ``timeout`` seconds for its reply."""
@@ -159,7 +175,7 @@ def _signal_name(number: int) -> str:
         return str(number)
 
 
-def _stop(process: subprocess.Popen, errors) -> None:
+def _stop(process: subprocess.Popen, errors, shared) -> None:
     """End a worker: closing its input ends its loop; one that does not end is killed."""
     try:
         process.stdin.close()
@@ -172,3 +188,4 @@ def _stop(process: subprocess.Popen, errors) -> None:
         process.wait()
     process.stdout.close()
     errors.close()
+    shared.close()

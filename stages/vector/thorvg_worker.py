@@ -1,13 +1,14 @@
 """The child process that runs ThorVG for :mod:`thorvg_renderer`, so a crash or hang of the native player stays here.
 
-Run as a script (``python thorvg_worker.py``): it imports only the standard library and
-``thorvg_python``, disables core dumps, and answers requests on stdin with replies on
+Run as a script (``python thorvg_worker.py FD``): it imports only the standard library
+and ``thorvg_python``, disables core dumps, and answers requests on stdin with replies on
 stdout until stdin closes. Each message is a header ``struct.pack(HEADER, kind, length)``
 followed by ``length`` bytes:
 
 * ``L`` load: ``key`` (u32) + Lottie JSON → ``K`` (loaded) or ``E`` + message;
 * ``R`` render: ``key`` (u32), frame from the in-point (f64), width, height (u32) →
-  ``K`` + (height, width, 4) premultiplied RGBA bytes, or ``E`` + message;
+  ``K`` + the byte count (u32) of the (height, width, 4) premultiplied RGBA frame, which
+  is in the shared file ``FD`` (so a frame does not go through the pipe), or ``E`` + message;
 * ``F`` forget: ``key`` (u32) → ``K``.
 
 The composition is fitted into the target as the SVG path fits it: scaled uniformly to
@@ -16,6 +17,7 @@ the largest size that fits and centred.
 
 from __future__ import annotations
 
+import mmap
 import os
 import resource
 import struct
@@ -24,6 +26,7 @@ import sys
 HEADER = ">cI"
 KEY = ">I"
 RENDER = ">IdII"
+COUNT = ">I"
 
 
 class Player:
@@ -58,7 +61,7 @@ class Player:
         canvas.update()
         canvas.draw(True)
         canvas.sync()
-        return bytes(canvas.buffer_arr)
+        return memoryview(canvas.buffer_arr).cast("B")
 
     def _fit(self, entry: dict, width: int, height: int) -> None:
         """Draw into ``width``×``height``, the picture scaled to fit and centred."""
@@ -77,13 +80,32 @@ class Player:
             entry["animation"]._del()
 
 
+class SharedFrame:
+    """The file the parent reads frames from, mapped again whenever the parent has resized it."""
+
+    def __init__(self, descriptor: int):
+        self.descriptor, self.view = descriptor, None
+
+    def write(self, frame) -> int:
+        size = os.fstat(self.descriptor).st_size
+        if self.view is None or len(self.view) != size:
+            if self.view is not None:
+                self.view.close()
+            self.view = mmap.mmap(self.descriptor, size)
+        count = len(frame)
+        if count > size:
+            raise ValueError(f"a frame of {count} bytes does not fit the shared file of {size}")
+        self.view[:count] = frame
+        return count
+
+
 def read_exactly(stream, count: int) -> bytes | None:
     """``count`` bytes from ``stream``, or None at the end of the stream."""
     data = stream.read(count)
     return data if len(data) == count else None
 
 
-def serve(requests, replies) -> None:
+def serve(requests, replies, shared: SharedFrame) -> None:
     """Answer requests until ``requests`` ends."""
     player = Player()
     header_size = struct.calcsize(HEADER)
@@ -93,7 +115,7 @@ def serve(requests, replies) -> None:
         if payload is None:
             return
         try:
-            reply = handle(player, kind, payload)
+            reply = handle(player, shared, kind, payload)
         except Exception as exc:  # the reply names the failure; the parent turns it into an InputError
             message = f"{type(exc).__name__}: {exc}".encode()
             replies.write(struct.pack(HEADER, b"E", len(message)) + message)
@@ -102,7 +124,7 @@ def serve(requests, replies) -> None:
         replies.flush()
 
 
-def handle(player: Player, kind: bytes, payload: bytes) -> bytes:
+def handle(player: Player, shared: SharedFrame, kind: bytes, payload: bytes) -> bytes:
     key_size = struct.calcsize(KEY)
     if kind == b"L":
         (key,) = struct.unpack_from(KEY, payload)
@@ -110,7 +132,7 @@ def handle(player: Player, kind: bytes, payload: bytes) -> bytes:
         return b""
     if kind == b"R":
         key, frame, width, height = struct.unpack(RENDER, payload)
-        return player.render(key, frame, width, height)
+        return struct.pack(COUNT, shared.write(player.render(key, frame, width, height)))
     if kind == b"F":
         (key,) = struct.unpack(KEY, payload)
         player.forget(key)
@@ -122,7 +144,7 @@ def main() -> None:
     resource.setrlimit(resource.RLIMIT_CORE, (0, 0))
     replies = os.fdopen(os.dup(1), "wb")
     os.dup2(2, 1)  # anything the native library prints goes to stderr, not into the replies
-    serve(sys.stdin.buffer, replies)
+    serve(sys.stdin.buffer, replies, SharedFrame(int(sys.argv[1])))
 
 
 if __name__ == "__main__":
