@@ -14,7 +14,6 @@ from fluidymation.errors import InputError
 from fluidymation.stages.vector import lottie_reader, svg_reader
 from fluidymation.stages.vector.base import DEFAULT_FPS, Reader, Renderer, Unsupported, VectorDocument, VectorLayer
 from fluidymation.stages.vector.cairosvg_renderer import CairoSvgRenderer
-from fluidymation.stages.vector.lottie_svg_renderer import LottieSvgRenderer
 from fluidymation.stages.vector.thorvg_renderer import ThorVGRenderer
 
 __all__ = ["DEFAULT_FPS", "READERS", "RENDERERS", "Reader", "Renderer", "Unsupported", "VectorDocument",
@@ -25,7 +24,7 @@ READERS: tuple[Reader, ...] = (
     lottie_reader.READER,
     svg_reader.SVG_READER,
 )
-RENDERERS: tuple[Renderer, ...] = (ThorVGRenderer(), LottieSvgRenderer(), CairoSvgRenderer())
+RENDERERS: tuple[Renderer, ...] = (ThorVGRenderer(), CairoSvgRenderer())
 
 
 def open_document(path: Path, *, split: tuple[str, ...] = (), fps: float | None = None) -> VectorDocument:
