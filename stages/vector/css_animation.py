@@ -23,9 +23,9 @@ from typing import Callable
 from xml.etree import ElementTree
 
 from fluidymation.stages.vector.base import Unsupported
-from fluidymation.stages.vector.css_geometry import fill_box
+from fluidymation.stages.vector.css_geometry import fill_box, uncomputed
 from fluidymation.stages.vector.css_selectors import DocumentIndex
-from fluidymation.stages.vector.css_stylesheet import (ANIMATION_DEFAULTS, CssWide, Keyframe, Keyframes, Stylesheet,
+from fluidymation.stages.vector.css_stylesheet import (ANIMATION_DEFAULTS, CssWide, Keyframes, Stylesheet,
                                                       parse_declarations, parse_stylesheets)
 from fluidymation.stages.vector.css_syntax import InvalidCss, Length, UnsupportedCss, length, tokens
 from fluidymation.stages.vector.css_timing import Timing
@@ -40,6 +40,8 @@ _TRANSFORM_DECLARATIONS = set(TRANSFORM_PROPERTIES) | {"transform-origin", "tran
 _COLOR = ColorKind(paint=False)
 _BLACK = (0.0, 0.0, 0.0, 1.0)
 _NOT_PRESENTATION = {"translate", "rotate", "scale"}
+#: Stands for the element's own value in a run's keyframes at 0 or 1 when its rule has none there.
+_UNDERLYING = object()
 
 
 def describe(element: ElementTree.Element, index: DocumentIndex) -> str:
@@ -85,9 +87,19 @@ class CssAnimation(Animation):
                          if (playing := self._animations(element, sheet))}
         animated = {name for playing in self._playing.values() for run in playing for name in run.keyframes.properties}
         self._transformed = [element for element in root.iter() if self._has_css_transform(element)]
-        self._fill_box = any(self._declared_value(element, "transform-box") == "fill-box" for element in root.iter())
+        fill_boxes = [element for element in root.iter() if self.declared_value(element, "transform-box") == "fill-box"]
+        for element in fill_boxes:
+            for tag in dict.fromkeys(uncomputed(element)):
+                self._report(describe(element, self.index), f"transform-box: fill-box: the box of <{tag}> is not "
+                             "computed; it adds nothing to the box")
+        self._fill_box = bool(fill_boxes)
         self._attributes = self._presentation_attributes(root, animated)
         self._elements = [element for element in root.iter() if id(element) in self._playing]
+        self._viewports: dict[int, tuple[float, float]] = {}
+        self._colors: dict[int, tuple] = {}
+        self._initial: dict[tuple[int, str], object] = {}
+        #: Resolved keyframes that do not change with time, by (element, property, run): see ``_Frame._points``.
+        self.points: dict[tuple[int, str, int], list[tuple]] = {}
         self.unsupported = tuple(dict.fromkeys(found))
 
     # The cascade: what each element declares, before any animation.
@@ -115,19 +127,19 @@ class CssAnimation(Animation):
                 declared[id(element)] = winners
         return declared
 
-    def _declared_value(self, element, name: str):
+    def declared_value(self, element, name: str):
         """The cascaded value of a property on ``element`` (``inherit`` followed up for animation properties)."""
         value = self._declared.get(id(element), {}).get(name)
         if isinstance(value, CssWide) and name in ANIMATION_DEFAULTS:
             parent = self.index.parent(element)
             if value.keyword == "inherit" and parent is not None:
-                return self._declared_value(parent, name)
+                return self.declared_value(parent, name)
             return None
         return value
 
     def _animations(self, element, sheet: Stylesheet) -> list[_Playing]:
         """The element's animations, one per ``animation-name`` item, the other lists repeated to its length."""
-        lists = {name: self._declared_value(element, name) or default for name, default in ANIMATION_DEFAULTS.items()}
+        lists = {name: self.declared_value(element, name) or default for name, default in ANIMATION_DEFAULTS.items()}
         names = lists["animation-name"]
         playing = []
         for number, name in enumerate(names):
@@ -178,6 +190,51 @@ class CssAnimation(Animation):
     def playing(self, element) -> list[_Playing]:
         return self._playing.get(id(element), [])
 
+    def initial(self, element, name: str):
+        """A property's initial value, resolved for the element."""
+        key = (id(element), name)
+        if key not in self._initial:
+            kind = PROPERTIES[name].kind
+            self._initial[key] = kind.resolve(kind.parse(tokens(PROPERTIES[name].initial)),
+                                              Context(self.viewport(element), self.color(element), lambda: None))
+        return self._initial[key]
+
+    def viewport(self, element) -> tuple[float, float]:
+        """The size of the element's nearest SVG viewport: its viewBox, else its width and height."""
+        if id(element) not in self._viewports:
+            viewport = self.index.parent(element) or element
+            while local_name(viewport.tag) != "svg" and self.index.parent(viewport) is not None:
+                viewport = self.index.parent(viewport)
+            self._viewports[id(element)] = self._viewport_size(viewport)
+        return self._viewports[id(element)]
+
+    def _viewport_size(self, svg) -> tuple[float, float]:
+        box = (svg.get("viewBox") or "").replace(",", " ").split()
+        try:
+            return float(box[2]), float(box[3])
+        except (IndexError, ValueError):
+            pass
+        sizes = []
+        for side in ("width", "height"):
+            try:
+                sizes.append(length(tokens(svg.get(side, ""))[0], unitless=True))
+            except (IndexError, InvalidCss, UnsupportedCss):
+                sizes.append(Length(100.0, True))
+        parent = self.index.parent(svg)
+        outer = self.viewport(parent) if parent is not None else (0.0, 0.0)
+        return sizes[0].px(outer[0]), sizes[1].px(outer[1])
+
+    def color(self, element) -> tuple:
+        """The element's ``color`` (for ``currentColor``): not animated here, inherited, black at the root."""
+        if id(element) not in self._colors:
+            specified = self.specified(element, "color")
+            parent = self.index.parent(element)
+            if isinstance(specified, tuple):
+                self._colors[id(element)] = specified
+            else:
+                self._colors[id(element)] = self.color(parent) if parent is not None else _BLACK
+        return self._colors[id(element)]
+
     # Playing it.
 
     def apply(self, at, time_seconds):
@@ -216,15 +273,21 @@ class _Frame:
     def __init__(self, animation: CssAnimation, time_seconds: float):
         self.animation, self.time = animation, time_seconds
         self._values: dict[tuple[int, str], object] = {}
-        self._colors: dict[int, tuple] = {}
+        self._progress: dict[int, float | None] = {}
+        self._contexts: dict[int, Context] = {}
         self._boxes: dict[int, Box] = {}
         self._matrices: dict[int, Matrix] = {}
+
+    def progress(self, run: _Playing) -> float | None:
+        if id(run) not in self._progress:
+            self._progress[id(run)] = run.timing.progress(self.time)
+        return self._progress[id(run)]
 
     def animated_names(self, element) -> list[str]:
         """Properties some animation of the element sets at this time."""
         names: dict[str, None] = {}
         for run in self.animation.playing(element):
-            if run.timing.progress(self.time) is not None:
+            if self.progress(run) is not None:
                 names.update(dict.fromkeys(run.keyframes.properties))
         return list(names)
 
@@ -234,10 +297,8 @@ class _Frame:
         if key not in self._values:
             result = self._base(element, name)
             for run in self.animation.playing(element):
-                frames = run.keyframes.properties.get(name)
-                progress = run.timing.progress(self.time) if frames else None
-                if progress is not None:
-                    result = self._sample(element, name, frames, progress, result, run.easing)
+                if name in run.keyframes.properties and self.progress(run) is not None:
+                    result = self._sample(element, name, run, result)
             self._values[key] = result
         return self._values[key]
 
@@ -246,7 +307,7 @@ class _Frame:
         specified = self.animation.specified(element, name)
         if specified is None or isinstance(specified, CssWide):
             return self._wide(element, name, specified.keyword if specified else "unset")
-        return PROPERTIES[name].kind.resolve(specified, self._context(element))
+        return PROPERTIES[name].kind.resolve(specified, self.context(element))
 
     def _wide(self, element, name: str, keyword: str):
         """``inherit``, ``initial`` or ``unset`` (what an unset property computes to)."""
@@ -254,84 +315,68 @@ class _Frame:
         inherits = keyword == "inherit" or (keyword != "initial" and PROPERTIES[name].inherited)
         if inherits and parent is not None:
             return self.value(parent, name)
-        kind = PROPERTIES[name].kind
-        return kind.resolve(kind.parse(tokens(PROPERTIES[name].initial)), self._context(element))
+        return self.animation.initial(element, name)
 
-    def _sample(self, element, name: str, frames: list[Keyframe], progress: float, underlying, easing):
-        """The keyframes' value at ``progress`` (Web Animations 1, "the effect value of a keyframe effect")."""
-        kind = PROPERTIES[name].kind
-        points = [(frame.offset, self._keyframe_value(element, name, frame.value), frame.easing or easing)
-                  for frame in frames]
-        if points[0][0] != 0:
-            points.insert(0, (0.0, underlying, easing))
-        if points[-1][0] != 1:
-            points.append((1.0, underlying, easing))
+    def _sample(self, element, name: str, run: _Playing, underlying):
+        """The keyframes' value at the run's progress (Web Animations 1, "the effect value of a keyframe effect")."""
+        progress = self.progress(run)
+        points = [(offset, underlying if value is _UNDERLYING else value, easing)
+                  for offset, value, easing in self._points(element, name, run)]
         if progress >= 1 and sum(point[0] == 1 for point in points) > 1:
             return points[-1][1]
         start = max((i for i, point in enumerate(points) if point[0] <= progress and point[0] < 1),
                     default=max(i for i, point in enumerate(points) if point[0] == 0))
         (start_offset, start_value, start_easing), (end_offset, end_value, _) = points[start], points[start + 1]
         distance = (progress - start_offset) / (end_offset - start_offset)
-        return kind.interpolate(start_value, end_value, start_easing(distance))
+        return PROPERTIES[name].kind.interpolate(start_value, end_value, start_easing(distance))
+
+    def _points(self, element, name: str, run: _Playing) -> list[tuple]:
+        """The run's keyframes of a property as (offset, resolved value, easing), with the element's own value
+        (:data:`_UNDERLYING`) at 0 and 1 when the rule has no keyframe there. Kept across frames unless a value
+        depends on the time (``inherit`` from an animated parent, a transform relative to an animated box)."""
+        key = (id(element), name, id(run))
+        cached = self.animation.points.get(key)
+        if cached is not None:
+            return cached
+        frames = run.keyframes.properties[name]
+        points = [(frame.offset, self._keyframe_value(element, name, frame.value), frame.easing or run.easing)
+                  for frame in frames]
+        if points[0][0] != 0:
+            points.insert(0, (0.0, _UNDERLYING, run.easing))
+        if points[-1][0] != 1:
+            points.append((1.0, _UNDERLYING, run.easing))
+        if name not in TRANSFORM_PROPERTIES and not any(isinstance(frame.value, CssWide) for frame in frames):
+            self.animation.points[key] = points
+        return points
 
     def _keyframe_value(self, element, name: str, value):
         if isinstance(value, CssWide):
             return self._wide(element, name, value.keyword)
-        return PROPERTIES[name].kind.resolve(value, self._context(element))
+        return PROPERTIES[name].kind.resolve(value, self.context(element))
 
-    def _context(self, element) -> Context:
-        return Context(self._viewport(element), self._color(element), lambda: self._reference_box(element))
-
-    def _viewport(self, element) -> tuple[float, float]:
-        """The size of the nearest SVG viewport: its viewBox, else its width and height."""
-        index = self.animation.index
-        viewport = index.parent(element) or element
-        while local_name(viewport.tag) != "svg" and index.parent(viewport) is not None:
-            viewport = index.parent(viewport)
-        box = (viewport.get("viewBox") or "").replace(",", " ").split()
-        if len(box) == 4:
-            return float(box[2]), float(box[3])
-        sizes = []
-        for side in ("width", "height"):
-            try:
-                size = length(tokens(viewport.get(side, ""))[0], unitless=True)
-            except (IndexError, InvalidCss, UnsupportedCss):
-                size = Length(100.0, True)
-            sizes.append(size)
-        parent = index.parent(viewport)
-        outer = self._viewport(parent) if parent is not None else (0.0, 0.0)
-        return sizes[0].px(outer[0]), sizes[1].px(outer[1])
-
-    def _color(self, element) -> tuple:
-        """The element's ``color`` (for ``currentColor``): not animated here, inherited, black at the root."""
-        if id(element) not in self._colors:
-            specified = self.animation.specified(element, "color")
-            parent = self.animation.index.parent(element)
-            if isinstance(specified, tuple):
-                self._colors[id(element)] = specified
-            else:
-                self._colors[id(element)] = self._color(parent) if parent is not None else _BLACK
-        return self._colors[id(element)]
+    def context(self, element) -> Context:
+        if id(element) not in self._contexts:
+            self._contexts[id(element)] = Context(self.animation.viewport(element), self.animation.color(element),
+                                                  lambda: self._reference_box(element))
+        return self._contexts[id(element)]
 
     def _reference_box(self, element) -> Box:
         """The ``transform-box``: the viewport (view-box, the default) or the element's fill box."""
         if id(element) not in self._boxes:
-            if self.animation._declared_value(element, "transform-box") == "fill-box":
-                self._boxes[id(element)] = fill_box(element, self._geometry, self._child_matrix)
+            if self.animation.declared_value(element, "transform-box") == "fill-box":
+                self._boxes[id(element)] = fill_box(element, self._geometry, self.matrix)
             else:
-                self._boxes[id(element)] = Box(0.0, 0.0, *self._viewport(element))
+                self._boxes[id(element)] = Box(0.0, 0.0, *self.animation.viewport(element))
         return self._boxes[id(element)]
 
     def _geometry(self, element, name: str) -> float:
+        """A geometry property in px for the fill box (``auto`` radii take the other radius, else 0)."""
         value = self.value(element, name)
         if isinstance(value, Keyword):
             other = {"rx": "ry", "ry": "rx"}.get(name)
             value = self.value(element, other) if other else 0.0
             return 0.0 if isinstance(value, Keyword) else value
         return value
-
-    def _child_matrix(self, element) -> Matrix:
-        return self.matrix(element)
 
     def matrix(self, element) -> Matrix:
         """The element's whole transform at this time: translate, rotate, scale and transform about the origin."""

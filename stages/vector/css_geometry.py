@@ -4,7 +4,8 @@ The fill box is the tight box of an element's geometry in its own user space, st
 left out (SVG 2, "Object bounding box"): exact for basic shapes and for path data
 (curve and arc extrema solved, not control points), and for a group the union of its
 children's boxes under their transforms. Geometry and transforms are read through
-callbacks, so animated values count.
+callbacks, so animated values count. Text, ``use`` and images are not measured
+(:func:`uncomputed` names them so they can be reported).
 """
 
 from __future__ import annotations
@@ -14,13 +15,13 @@ import re
 from typing import Callable
 from xml.etree import ElementTree
 
-from fluidymation.stages.vector.css_syntax import UnsupportedCss
 from fluidymation.stages.vector.css_transform import Box, Matrix
 from fluidymation.stages.vector.safety import local_name
 
 Point = tuple[float, float]
 _POINTS_NUMBER = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?")
 _GROUPS = {"g", "a", "switch"}
+_SHAPES = {"rect", "circle", "ellipse", "line", "polyline", "polygon", "path"}
 _NOT_GEOMETRY = {"title", "desc", "metadata", "style", "script", "defs", "linearGradient", "radialGradient",
                  "pattern", "clipPath", "mask", "filter", "marker", "symbol"}
 
@@ -62,7 +63,15 @@ def _points(element, value, transform) -> list[Point]:
             matrix = transform(child)
             points += [_apply(matrix, point) for point in _corners(_points(child, value, transform))]
         return points
-    raise UnsupportedCss(f"the fill-box of <{tag}> is not computed")
+    return []
+
+
+def uncomputed(element: ElementTree.Element) -> list[str]:
+    """Tags in the element's fill box whose geometry is not computed here (text, use, image...): they add nothing."""
+    tag = local_name(element.tag)
+    if tag in _GROUPS:
+        return [name for child in element if local_name(child.tag) not in _NOT_GEOMETRY for name in uncomputed(child)]
+    return [] if tag in _SHAPES else [tag]
 
 
 def _corners(points: list[Point]) -> list[Point]:

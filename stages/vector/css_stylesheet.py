@@ -113,6 +113,26 @@ def parse_stylesheets(root: ElementTree.Element, report: Report) -> Stylesheet:
     return sheet
 
 
+def _add_media(sheet: Stylesheet, rule, report: Report) -> None:
+    """A ``@media`` block: its rules join the sheet when the query holds; the rasterizer applies none of them, so
+    what they set besides animations is reported."""
+    where = f"<style> @media {text_of(rule.prelude)}"
+    matches = media_matches(rule.prelude)
+    if matches is None:
+        report(where, "this media query is not evaluated; its rules are not applied")
+    if not matches:
+        return
+    for inner in tinycss2.parse_rule_list(rule.content, skip_comments=True, skip_whitespace=True):
+        _add_rule(sheet, inner, report)
+        if inner.type == "qualified-rule":
+            names = {item.lower_name for item in tinycss2.parse_blocks_contents(inner.content, skip_comments=True,
+                                                                                skip_whitespace=True)
+                     if item.type == "declaration" and not _played_from_media(item.lower_name)}
+            if names:
+                report(f"{where} {text_of(inner.prelude)}", f"{', '.join(sorted(names))}: the rasterizer does "
+                       "not apply @media rules, so only their animations are played")
+
+
 def _add_rule(sheet: Stylesheet, rule, report: Report) -> None:
     if rule.type == "error":
         report("<style>", f"CSS syntax error at line {rule.source_line}: {rule.message}; skipped")
@@ -122,6 +142,8 @@ def _add_rule(sheet: Stylesheet, rule, report: Report) -> None:
             keyframes = _keyframes(rule, report)
             if keyframes is not None:
                 sheet.keyframes[keyframes.name] = keyframes
+        elif keyword == "media" and rule.content is not None:
+            _add_media(sheet, rule, report)
         elif keyword != "charset":
             report(f"<style> @{keyword}", "this at-rule is not applied")
     else:
@@ -134,6 +156,47 @@ def _add_rule(sheet: Stylesheet, rule, report: Report) -> None:
         declarations = parse_declarations(rule.content, where, report)
         if declarations:
             sheet.rules.append(Rule(selectors, declarations, len(sheet.rules)))
+
+
+#: Media features as a browser with default settings on a screen answers them.
+_MEDIA_FEATURES = {"prefers-reduced-motion": "no-preference", "prefers-color-scheme": "light",
+                   "prefers-contrast": "no-preference", "forced-colors": "none", "prefers-reduced-transparency":
+                   "no-preference", "prefers-reduced-data": "no-preference", "inverted-colors": "none",
+                   "scripting": "enabled"}
+
+
+def media_matches(prelude) -> bool | None:
+    """Whether a ``@media`` query list holds on a screen with default preferences, or None when not evaluated
+    (sizes, ``not``, ``or``, other features)."""
+    try:
+        answers = [_query_matches(query) for query in split_commas(prelude)]
+    except InvalidCss:
+        return None
+    if True in answers:
+        return True
+    return False if all(answer is False for answer in answers) else None
+
+
+def _query_matches(query: list) -> bool | None:
+    """A query of media types and ``(feature: value)`` tests joined by ``and`` (``not`` and ``or``: None)."""
+    if any(ident(value) in ("not", "or") for value in query):
+        return None
+    answers = []
+    for value in query:
+        word = ident(value)
+        if word in ("and", "only"):
+            continue
+        if word is not None:
+            answers.append({"screen": True, "all": True, "print": False, "speech": False}.get(word))
+        elif value.type == "() block":
+            feature = [ident(part) for part in significant(value.content) if part.type == "ident"]
+            known = _MEDIA_FEATURES.get(feature[0]) if len(feature) == 2 else None
+            answers.append(None if known is None else feature[1] == known)
+        else:
+            answers.append(None)
+    if False in answers:
+        return False
+    return True if all(answers) else None
 
 
 def parse_declarations(content, where: str, report: Report) -> list[Declaration]:
@@ -167,6 +230,12 @@ def _declaration(item, where: str, report: Report) -> list[Declaration]:
     except UnsupportedCss as exc:
         report(where, f"'{name}: {text_of(item.value)}': {exc}; ignored")
     return []
+
+
+def _played_from_media(name: str) -> bool:
+    """Properties this reader writes itself (animations and transforms), so a ``@media`` rule's value still counts."""
+    return (name == "animation" or name in ANIMATION_DEFAULTS or name in _ONLY_INITIAL
+            or name in ("transform", "translate", "rotate", "scale", "transform-origin", "transform-box"))
 
 
 def _read(name: str) -> bool:

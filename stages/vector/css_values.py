@@ -58,7 +58,7 @@ class Kind(ABC):
         return start + (end - start) * progress
 
     def serialize(self, value) -> str:
-        return _number(value)
+        return value.text if isinstance(value, Keyword) else _number(value)
 
     def interpolate(self, start, end, progress: float):
         """Resolved ``start`` to ``end`` at ``progress``: blended, or discrete when either cannot interpolate."""

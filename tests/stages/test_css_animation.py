@@ -260,6 +260,8 @@ def test_unsupported_css_is_reported_naming_the_rule_or_element():
     root, animation = _svg(
         "@keyframes spin { to { filter: blur(2px); transform: rotate3d(1, 0, 0, 40deg); opacity: var(--o) } }"
         "@media (min-width: 10px) { rect { fill: red } }"
+        "@media (prefers-reduced-motion: reduce) { * { animation: none } }"
+        "@media screen { .c { fill: red } } @supports (display: grid) { }"
         ".c:focus-visible:blink { fill: red }"
         "rect { animation: spin 1s linear(0, 1), none 2s; animation-composition: add; transform-box: stroke-box }"
         "#r { animation-name: ghost }",
@@ -270,7 +272,10 @@ def test_unsupported_css_is_reported_naming_the_rule_or_element():
         ("<style> @keyframes spin to", "'transform: rotate3d(1, 0, 0, 40deg)': the 3D transform function rotate3d() "
                                        "is not drawn"),
         ("<style> @keyframes spin to", "'opacity: var(--o)': var() is not evaluated"),
-        ("<style> @media", "this at-rule is not applied"),
+        ("<style> @media (min-width: 10px)", "this media query is not evaluated"),
+        ("<style> @media screen .c", "fill: the rasterizer does not apply @media rules, so only their animations are "
+                                     "played"),
+        ("<style> @supports", "this at-rule is not applied"),
         ("<style> .c:focus-visible:blink", "the pseudo-class ':blink' in '.c:focus-visible:blink' is not matched"),
         ("<style> rect", "'animation: spin 1s linear(0, 1), none 2s': the linear() easing function with stops is not "
                          "evaluated"),
