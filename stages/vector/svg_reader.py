@@ -165,9 +165,10 @@ class Animation(ABC):
 
 
 from fluidymation.stages.vector.smil import parse_smil  # noqa: E402  (it subclasses Animation)
+from fluidymation.stages.vector.css_animation import parse_css_animation  # noqa: E402  (it subclasses Animation)
 
 #: Parsers of the animation languages a file may hold: ``parse(root, source) -> Animation | None``.
-ANIMATIONS: tuple[Callable[[ElementTree.Element, str], Animation | None], ...] = (parse_smil,)
+ANIMATIONS: tuple[Callable[[ElementTree.Element, str], Animation | None], ...] = (parse_smil, parse_css_animation)
 
 
 class SvgFrame(NamedTuple):
