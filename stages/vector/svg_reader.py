@@ -249,7 +249,7 @@ def open_svg_sequence(pattern: Path, *, split: tuple[str, ...] = (), fps: float 
     return SvgSequenceDocument(str(pattern), sequence_files(pattern), fps or DEFAULT_FPS)
 
 
-SVG_READER = Reader("svg", 2, (".svg",), open_svg)
+SVG_READER = Reader("svg", 3, (".svg",), open_svg)
 SEQUENCE_READER = Reader("svg-sequence", 2, (".svg",), open_svg_sequence, sequence=True)
 
 
