@@ -45,7 +45,7 @@ class VectorLayer:
 class VectorDocument(ABC):
     """A vector animation as read from its file(s): named layers, size and timing.
 
-    Subclasses set ``path``, ``kind`` (lottie, dotlottie, tgs, svg, svg-smil,
+    Subclasses set ``path``, ``kind`` (lottie, dotlottie, tgs, svg,
     svg-sequence), ``reader`` and ``reader_version`` (the reader that opened it),
     ``width``, ``height`` (native size, px), ``native_fps`` (None when the file has no
     frame rate), ``layers`` (bottom to top) and ``files`` (every file whose content is
