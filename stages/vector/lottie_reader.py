@@ -379,16 +379,16 @@ def _with_matte_sources(layers: list[dict], indices: set[int]) -> set[int]:
     (Lottie 5.12 and later), else from the layer just above it.
     """
     by_ind = {layer.get("ind"): i for i, layer in enumerate(layers) if "ind" in layer}
-    needed, todo = set(indices), list(indices)
-    while todo:
-        index = todo.pop()
+    needed, unvisited = set(indices), list(indices)
+    while unvisited:
+        index = unvisited.pop()
         layer = layers[index]
         if not layer.get("tt"):
             continue
         source = by_ind.get(layer["tp"]) if "tp" in layer else index - 1
         if source is not None and source >= 0 and source not in needed:
             needed.add(source)
-            todo.append(source)
+            unvisited.append(source)
     return needed
 
 
