@@ -1,10 +1,9 @@
 """The plain-SVG readers: a single file (static, or animated) or a numbered sequence of files.
 
-Layers are the top-level ``<g>`` elements of the root ``<svg>``, named by
-``inkscape:label`` or else ``id`` (``group N`` when neither is set). A file without
-top-level groups has each top-level drawable element (shape, text, use, image, link,
-nested svg) as a layer, named by ``inkscape:label``, else ``id``, else its tag and its
-place among them (``circle 2``: the third). To isolate some layers, every other
+Layers are the top-level drawable elements of the root ``<svg>`` (groups, shapes, text,
+use, image, link, nested svg), named by ``inkscape:label``, else ``id``, else ``group N``
+for a group and the tag and its place among the other elements for the rest
+(``circle 2``: the third element that is not a group). To isolate some layers, every other
 top-level drawable element is given ``display: none`` in its style (over any style sheet
 or animated value).
 
@@ -96,14 +95,21 @@ def undrawn(root: ElementTree.Element) -> tuple[Unsupported, ...]:
 
 
 def _top_layers(root: ElementTree.Element) -> list[tuple[ElementTree.Element, str]]:
-    """The layers' elements and names: the top-level groups, or without any, the top-level drawable elements."""
-    drawn = [element for element in root if local_name(element.tag) in _DRAWN]
-    groups = [element for element in drawn if local_name(element.tag) == "g"]
-    if groups:
-        return [(element, element.get(INKSCAPE_LABEL) or element.get("id") or f"group {index}")
-                for index, element in enumerate(groups)]
-    return [(element, element.get(INKSCAPE_LABEL) or element.get("id") or f"{local_name(element.tag)} {index}")
-            for index, element in enumerate(drawn)]
+    """The layers' elements and names: every top-level drawable element, groups and shapes alike.
+
+    A group without a label or id is ``group N`` (N counts the groups), any other element
+    ``<tag> N`` (N counts the top-level drawable elements that are not groups)."""
+    layers = []
+    counts = {"group": 0, "other": 0}
+    for element in root:
+        tag = local_name(element.tag)
+        if tag not in _DRAWN:
+            continue
+        kind = "group" if tag == "g" else "other"
+        fallback = f"group {counts[kind]}" if kind == "group" else f"{tag} {counts[kind]}"
+        counts[kind] += 1
+        layers.append((element, element.get(INKSCAPE_LABEL) or element.get("id") or fallback))
+    return layers
 
 
 def _layer_names(root: ElementTree.Element) -> list[str]:

@@ -108,9 +108,21 @@ def test_svg_layers_are_top_level_groups_by_label_then_id(tmp_path):
                     '<g id="g1" inkscape:label="Left"><rect width="20" height="20" fill="#f00"/></g>'
                     '<g id="right"><rect x="20" width="20" height="20" fill="#00f"/></g></svg>')
     document = open_document(path)
-    assert document.layer_names() == ["Left", "right"]
+    assert document.layer_names() == ["rect 0", "Left", "right"]  # the background rect beside the groups too
     assert coverage(document, ["Left"], 0).sum() == pytest.approx(400)
-    assert coverage(document, ["Left", "right"], 0).sum() == pytest.approx(800)  # the background rect is no layer
+    assert coverage(document, ["Left", "right"], 0).sum() == pytest.approx(800)
+    assert coverage(document, ["rect 0"], 0).sum() == pytest.approx(800)
+
+
+def test_svg_groups_and_shapes_beside_them_are_numbered_apart(tmp_path):
+    path = tmp_path / "mixed.svg"
+    path.write_text('<svg xmlns="http://www.w3.org/2000/svg" width="40" height="10"><g><rect width="10" height="10"/>'
+                    '</g><circle cx="15" cy="5" r="5"/><g><rect x="20" width="10" height="10"/></g>'
+                    '<rect x="30" width="10" height="10"/></svg>')
+    document = open_document(path)
+    assert document.layer_names() == ["group 0", "circle 0", "group 1", "rect 1"]
+    assert coverage(document, ["rect 1"], 0)[:, 30:].sum() == pytest.approx(100)
+    assert coverage(document, ["rect 1"], 0)[:, :30].sum() == 0
 
 
 def test_svg_without_groups_has_a_layer_per_top_level_element(tmp_path):
