@@ -60,7 +60,7 @@ def _mask_settings(work) -> MaskSettings:
 def _mask_inputs(work) -> dict:
     document, renderer = work.plan.document, work.plan.renderer
     return {"files": input_digest(work.plan), "reader": [document.reader, document.reader_version],
-            "renderer": [renderer.name, renderer.version]}
+            "choices": document.choices, "renderer": [renderer.name, renderer.version]}
 
 
 def _run_masks(work, key: str) -> Done:

@@ -76,7 +76,8 @@ def plan_scene(scene: Scene, *, strict: bool = False) -> Plan:
     What the input holds that cannot be rendered faithfully is logged as a warning, each
     naming the file and the element; with ``strict`` it is an InputError instead.
     """
-    document = open_document(scene.input, split=scene.split, fps=scene.fps)
+    document = open_document(scene.input, split=scene.split, fps=scene.fps, animation=scene.animation,
+                             theme=scene.theme)
     report_unsupported(document, strict=strict)
     fps = scene.fps or document.native_fps or DEFAULT_FPS
     default_start, default_end = document.frame_range(fps)

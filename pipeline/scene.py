@@ -27,7 +27,7 @@ PREVIEW_FORMATS = ("gif", "webp")
 EXEMPLAR_KINDS = ("builtin", "video", "images")
 _LAYER_NAME = re.compile(r"^[A-Za-z0-9_][A-Za-z0-9_.\- ]*$")
 
-_TOP_KEYS = ("version", "input", "fps", "frames", "size", "scale", "seed", "split", "output",
+_TOP_KEYS = ("version", "input", "animation", "theme", "fps", "frames", "size", "scale", "seed", "split", "output",
              "background", "exemplars", "defaults", "layers")
 _LAYER_KEYS = ("name", "select", "color", "exemplar", "stylizer", "colorize", "blend", "opacity", "params")
 _DEFAULT_KEYS = ("exemplar", "stylizer", "colorize", "blend", "opacity", "params")
@@ -76,6 +76,8 @@ class LayerSpec:
 class Scene:
     path: Path
     input: Path
+    animation: str | None  # a dotLottie's animation and theme, by id (None: its first / its initial one)
+    theme: str | None
     fps: float | None
     frames: FrameRange | None
     size: tuple[int, int] | None
@@ -120,6 +122,8 @@ def load_scene(path: str | Path) -> Scene:
     return Scene(
         path=path.resolve(),
         input=check.path(("input",)),
+        animation=check.text(("animation",), None),
+        theme=check.text(("theme",), None),
         fps=check.number(("fps",), None, above=0, maximum=MAX_FPS),
         frames=_frames(check),
         size=_size(check),

@@ -31,6 +31,8 @@ def describe(plan: Plan) -> str:
         f"scene:   {scene.path}",
         f"input:   {scene.input} ({document.kind}, {document.width:g}x{document.height:g} px, {native_fps})",
         f"reader:  {document.reader} v{document.reader_version}, renderer {renderer.name} v{renderer.version}",
+        *([f"picked:  {', '.join(f'{name} {value}' for name, value in document.choices.items())}"]
+          if document.choices else []),
         f"size:    {plan.size[0]}x{plan.size[1]} px",
         f"fps:     {plan.fps:g}",
         f"frames:  {plan.start}:{plan.end} ({plan.frame_count} frames)",

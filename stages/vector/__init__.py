@@ -27,15 +27,22 @@ READERS: tuple[Reader, ...] = (
 RENDERERS: tuple[Renderer, ...] = (ThorVGRenderer(), CairoSvgRenderer())
 
 
-def open_document(path: Path, *, split: tuple[str, ...] = (), fps: float | None = None) -> VectorDocument:
+def open_document(path: Path, *, split: tuple[str, ...] = (), fps: float | None = None,
+                  **options: str | None) -> VectorDocument:
     """Open the vector animation at ``path`` (a file, or a pattern of numbered SVG files).
 
     ``split`` lists precomp layer names (or globs) to be split into their children; ``fps``
     is the scene's frame rate, if it sets one (a numbered sequence shows a file per frame).
+    ``options`` are the scene's reader options (``animation``, ``theme``); None is unset.
     """
+    given = {name: value for name, value in options.items() if value is not None}
     for reader in READERS:
         if reader.takes(path):
-            return reader.open(path, split=split, fps=fps)
+            for name in given:
+                if name not in reader.options:
+                    raise InputError(f"{path}: the scene's '{name}' does not apply to this input (the {reader.name} "
+                                     f"reader takes {', '.join(reader.options) or 'no options'})")
+            return reader.open(path, split=split, fps=fps, **given)
     raise InputError(f"{path}: unknown input type '{path.suffix.lower() or path.name}'; expected a Lottie .json, "
                      ".lottie or .tgs file, an .svg file, or a numbered SVG pattern such as frames/%04d.svg")
 

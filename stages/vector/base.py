@@ -50,7 +50,8 @@ class VectorDocument(ABC):
     ``width``, ``height`` (native size, px), ``native_fps`` (None when the file has no
     frame rate), ``layers`` (bottom to top) and ``files`` (every file whose content is
     read), and implement :meth:`frame_range` and :meth:`isolate`. ``unsupported`` lists
-    what the reader found it cannot render faithfully (warned about, refused with ``--strict``).
+    what the reader found it cannot render faithfully (warned about, refused with ``--strict``);
+    ``choices`` what was picked inside the file (a dotLottie's animation and theme, by id).
     """
 
     path: Path
@@ -63,6 +64,7 @@ class VectorDocument(ABC):
     layers: list[VectorLayer]
     files: list[Path]
     unsupported: tuple[Unsupported, ...] = ()
+    choices: dict[str, str] = {}
 
     @abstractmethod
     def frame_range(self, fps: float) -> tuple[int, int]:
@@ -98,7 +100,8 @@ class Reader:
 
     A path is taken when its suffix is one of ``suffixes``, it is a numbered pattern
     (``frames/%04d.svg``) if ``sequence`` is set, and ``claims(path)`` (when given, a look
-    at the content) agrees. ``open(path, split=..., fps=...)`` returns the document.
+    at the content) agrees. ``open(path, split=..., fps=..., **options)`` returns the
+    document; ``options`` names the scene keys it takes besides (a dotLottie's ``animation``).
     """
 
     name: str
@@ -107,6 +110,7 @@ class Reader:
     open: Callable[..., VectorDocument]
     sequence: bool = False
     claims: Callable[[Path], bool] | None = None
+    options: tuple[str, ...] = ()
 
     def takes(self, path: Path) -> bool:
         """Whether this reader opens ``path``."""

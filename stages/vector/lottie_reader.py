@@ -73,8 +73,9 @@ class LottieDocument(VectorDocument):
 
     def __init__(self, path: Path, data: dict, *, kind: str, reader: Reader, split: tuple[str, ...] = (),
                  native_fps: float | None = None, images: tuple[Path, ...] = (),
-                 unsupported: tuple[Unsupported, ...] = ()):
+                 unsupported: tuple[Unsupported, ...] = (), choices: dict[str, str] | None = None):
         self.path = path
+        self.choices = choices or {}
         self.kind = kind
         self.reader, self.reader_version = reader.name, reader.version
         self.files = [path, *images]
@@ -114,15 +115,24 @@ class LottieDocument(VectorDocument):
         return PlayerFrame(self._isolated[key], self.lottie_frame(time_seconds) - self.in_point)
 
 
-def open_lottie(path: Path, *, split: tuple[str, ...] = (), fps: float | None = None) -> LottieDocument:
-    """Open a .json, .lottie or .tgs file (``fps`` is not needed: the file has its own)."""
+def open_lottie(path: Path, *, split: tuple[str, ...] = (), fps: float | None = None,
+                animation: str | None = None, theme: str | None = None) -> LottieDocument:
+    """Open a .json, .lottie or .tgs file (``fps`` is not needed: the file has its own).
+
+    Of a dotLottie archive, ``animation`` picks an animation of its manifest by id (default
+    the first) and ``theme`` a theme by id (default the animation's ``initialTheme``).
+    """
     suffix = path.suffix.lower()
     raw = read_file(path)
-    theme_rules_skipped = []
+    theme_rules_skipped, choices = [], {}
+    if suffix != ".lottie" and (animation is not None or theme is not None):
+        option = "animation" if animation is not None else "theme"
+        raise InputError(f"{path}: the scene's '{option}' picks an animation or theme of a dotLottie archive "
+                         f"(.lottie); this input has only one animation and no themes")
     if suffix == ".tgs":
         data = _parse_json(gunzip_limited(raw, str(path)), str(path))
     elif suffix == ".lottie":
-        data, theme_rules_skipped = _read_dotlottie(raw, path)
+        data, theme_rules_skipped, choices = _read_dotlottie(raw, path, animation, theme)
     else:
         data = _parse_json(raw, str(path))
     _check_structure(data, str(path))
@@ -130,10 +140,10 @@ def open_lottie(path: Path, *, split: tuple[str, ...] = (), fps: float | None = 
     images = _embed_images_beside(data, path)
     return LottieDocument(path, data, kind={".tgs": "tgs", ".lottie": "dotlottie"}.get(suffix, "lottie"),
                           reader=READER, split=split, native_fps=float(data["fr"]), images=images,
-                          unsupported=tuple(theme_rules_skipped + _unsupported(data)))
+                          unsupported=tuple(theme_rules_skipped + _unsupported(data)), choices=choices)
 
 
-READER = Reader("lottie", 2, (".json", ".lottie", ".tgs"), open_lottie)
+READER = Reader("lottie", 2, (".json", ".lottie", ".tgs"), open_lottie, options=("animation", "theme"))
 
 
 def _parse_json(raw: bytes, source: str) -> dict:
@@ -148,12 +158,14 @@ def _parse_json(raw: bytes, source: str) -> dict:
     return data
 
 
-def _read_dotlottie(raw: bytes, path: Path) -> tuple[dict, list[Unsupported]]:
-    """The first animation of a dotLottie archive (the first of its manifest, else the first by name).
+def _read_dotlottie(raw: bytes, path: Path, animation: str | None,
+                    theme: str | None) -> tuple[dict, list[Unsupported], dict[str, str]]:
+    """An animation of a dotLottie archive: ``animation`` by id, else the manifest's first (else the first by name).
 
     Both layouts are read: version 1 (``animations/``, ``images/``) and 2 (``a/``, ``i/``,
-    themes in ``t/``). The animation's ``initialTheme`` is applied (:func:`_apply_theme`);
-    returned with the animation are the theme's rules that are not applied.
+    themes in ``t/``). The theme ``theme``, else the animation's ``initialTheme``, is
+    applied (:func:`_apply_theme`). Returned with the animation are the theme's rules that
+    are not applied and the animation and theme chosen (by id).
     """
     import io
 
@@ -166,26 +178,45 @@ def _read_dotlottie(raw: bytes, path: Path) -> tuple[dict, list[Unsupported]]:
         names = safe_zip_member_names(archive, source)
         manifest = _parse_json(read_zip_member(archive, "manifest.json", source), f"{source}:manifest.json") \
             if "manifest.json" in names else {}
-        animations = manifest.get("animations") if isinstance(manifest.get("animations"), list) else []
-        first = animations[0].get("id") if animations and isinstance(animations[0], dict) else None
-        candidates = [f"{folder}/{first}.json" for folder in _DOTLOTTIE_ANIMATIONS] if first else []
-        candidates += sorted(n for n in names if n.split("/")[0] in _DOTLOTTIE_ANIMATIONS and n.endswith(".json")
-                             and n.count("/") == 1)
-        member = next((n for n in candidates if n in names), None)
-        if member is None:
-            raise InputError(f"{source}: the dotLottie archive holds no animations/*.json (or a/*.json)")
+        listed = [entry for entry in _list(manifest.get("animations")) if isinstance(entry, dict)
+                  and isinstance(entry.get("id"), str)]
+        stored = sorted(n for n in names if n.split("/")[0] in _DOTLOTTIE_ANIMATIONS and n.endswith(".json")
+                        and n.count("/") == 1)
+        if animation is not None:
+            entry = next((entry for entry in listed if entry["id"] == animation), {"id": animation})
+            member = next((m for m in stored if m.split("/")[1] == f"{animation}.json"), None)
+            if member is None:
+                held = ", ".join(m.split("/")[1][:-5] for m in stored) or "none"
+                raise InputError(f"{source}: the scene's animation '{animation}' is not in the archive "
+                                 f"(its animations: {held})")
+        else:
+            entry = listed[0] if listed else {}
+            candidates = [f"{folder}/{entry['id']}.json" for folder in _DOTLOTTIE_ANIMATIONS] if entry else []
+            member = next((n for n in candidates + stored if n in names), None)
+            if member is None:
+                raise InputError(f"{source}: the dotLottie archive holds no animations/*.json (or a/*.json)")
+            if entry and not member.endswith(f"/{entry['id']}.json"):
+                entry = {}
         data = _parse_json(read_zip_member(archive, member, source), f"{source}:{member}")
         _embed_archive_images(data, archive, names, source)
-        theme = animations[0].get("initialTheme") if first and member.endswith(f"/{first}.json") else None
+        chosen = member.split("/")[1][:-5]
+        choices = {"animation": chosen}
         skipped = []
-        if isinstance(theme, str):
+        if theme is None:
+            theme = entry.get("initialTheme") if isinstance(entry.get("initialTheme"), str) else None
+            where = "the manifest's initial theme"
+        else:
+            where = "the scene's theme"
+        if theme is not None:
             theme_member = f"t/{theme}.json"
             if theme_member not in names:
-                raise InputError(f"{source}: the manifest's initial theme '{theme}' is not in the archive "
-                                 f"({theme_member})")
+                held = ", ".join(n[2:-5] for n in names if n.startswith("t/") and n.endswith(".json")) or "none"
+                raise InputError(f"{source}: {where} '{theme}' is not in the archive ({theme_member}; "
+                                 f"its themes: {held})")
             rules = _parse_json(read_zip_member(archive, theme_member, source), f"{source}:{theme_member}")
-            skipped = _apply_theme(data, rules, theme, first)
-    return data, skipped
+            skipped = _apply_theme(data, rules, theme, chosen)
+            choices["theme"] = theme
+    return data, skipped, choices
 
 
 def _apply_theme(data: dict, theme: dict, name: str, animation: str) -> list[Unsupported]:

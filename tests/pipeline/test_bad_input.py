@@ -154,6 +154,15 @@ def test_impossible_sizes_and_ranges(cli, tmp_path, extra, fragment):
     assert_refused(cli, scene_for(tmp_path, "m.json", extra), "scene.yaml", fragment)
 
 
+@pytest.mark.parametrize("extra,fragment", [
+    ("animation: second\n", "picks an animation or theme of a dotLottie archive"),
+    ("theme: [dark]\n", "theme: expected text"),
+])
+def test_dotlottie_choices_on_other_inputs(cli, tmp_path, extra, fragment):
+    shutil.copy(DATA / "matte.json", tmp_path / "m.json")
+    assert_refused(cli, scene_for(tmp_path, "m.json", extra), fragment, command="check")
+
+
 def test_output_size_from_scale_over_limit(cli, tmp_path):
     data = json.loads((DATA / "matte.json").read_text())
     data["w"] = 2000  # 2000 px * 10 > 16384

@@ -116,6 +116,15 @@ def test_a_change_of_the_input_file_or_the_renderer_invalidates_the_masks_onward
     assert _changed(keys, render._Run(bumped, Options()).keys.all()) == _invalidated("masks")
 
 
+def test_a_dotlottie_theme_picked_in_the_scene_invalidates_the_masks_onwards(tmp_path):
+    themed = ROOT / "tests" / "data" / "lottie" / "themed.lottie"
+    scene = write_scene(tmp_path, f"version: 1\ninput: {themed}\nsize: [32, 32]\nframes: {{start: 0, end: 2}}\n"
+                                  "output: {dir: out, video: film.mp4}\nlayers:\n  - {name: square}\n")
+    before = _keys(scene)
+    after = _keys(_edit(scene, "size: [32, 32]", "theme: recoloured\nsize: [32, 32]"))
+    assert _changed(before, after) == _invalidated("masks", ["square"])
+
+
 class _Renamed:
     """The plan's renderer under another version."""
 

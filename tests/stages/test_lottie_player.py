@@ -7,6 +7,7 @@ checked instead (tests/data/lottie/README.md gives each fixture's numbers).
 
 import json
 import pickle
+import re
 import shutil
 import struct
 import sys
@@ -210,6 +211,28 @@ def test_dotlottie_initial_theme_is_applied():
     assert box(rgba[:, :, 3] / 255) == (64, 80, 64, 80) and tuple(rgba[72, 72]) == (230, 26, 26, 255)
     assert [(item.element, item.message) for item in document.unsupported] == [
         ("theme 'moved' rules[2] 'logo'", "a rule of type Image, which is not applied")]
+
+
+def test_dotlottie_animation_and_theme_are_picked_by_id():
+    second = open_document(DATA / "two_animations.lottie", animation="second")
+    assert second.layer_names() == ["second square"] and second.choices == {"animation": "second"}
+    assert box(coverage(second, ["second square"], 0)) == (64, 80, 64, 80)
+    recoloured = open_document(DATA / "themed.lottie", theme="recoloured")
+    assert recoloured.choices == {"animation": "themed", "theme": "recoloured"} and not recoloured.unsupported
+    rgba = ThorVGRenderer().render(recoloured, ["square"], 0, (96, 96))
+    assert box(rgba[:, :, 3] / 255) == (16, 32, 16, 32) and tuple(rgba[24, 24]) == (26, 204, 26, 255)
+
+
+@pytest.mark.parametrize("path, options, message", [
+    ("two_animations.lottie", {"animation": "third"}, "animation 'third' is not in the archive (its animations: "
+                                                      "first, second)"),
+    ("themed.lottie", {"theme": "dark"}, "the scene's theme 'dark' is not in the archive (t/dark.json; its themes: "
+                                         "moved, recoloured)"),
+    ("parenting.json", {"theme": "dark"}, "the scene's 'theme' picks an animation or theme of a dotLottie archive"),
+])
+def test_dotlottie_choices_that_do_not_exist_are_refused(path, options, message):
+    with pytest.raises(InputError, match=re.escape(message)):
+        open_document(DATA / path, **options)
 
 
 def test_the_files_own_slots_are_used(tmp_path):

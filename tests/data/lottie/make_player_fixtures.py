@@ -137,6 +137,8 @@ THEMED = animation("themed", [shape_layer(1, "square", [group(
 MOVED = {"rules": [{"id": "squarePosition", "type": "Position", "value": [72, 72]},
                    {"id": "squareColour", "type": "Color", "value": [0.9, 0.1, 0.1, 1]},
                    {"id": "logo", "type": "Image", "value": {"id": "img", "width": 8, "height": 8}}]}
+#: its second theme "recoloured" sets only the colour
+RECOLOURED = {"rules": [{"id": "squareColour", "type": "Color", "value": [0.1, 0.8, 0.1, 1]}]}
 
 
 def png(width, height, rgba):
@@ -180,7 +182,7 @@ def main():
     (HERE / "image_beside" / "images").mkdir(exist_ok=True)
     (HERE / "image_beside" / "images" / "dot.png").write_bytes(png(32, 32, (200, 40, 40, 255)))
     write_dotlottie(HERE / "two_animations.lottie", [("first", FIRST), ("second", SECOND)])
-    write_dotlottie_v2(HERE / "themed.lottie", "themed", THEMED, {"moved": MOVED})
+    write_dotlottie_v2(HERE / "themed.lottie", "themed", THEMED, {"moved": MOVED, "recoloured": RECOLOURED})
 
 
 if __name__ == "__main__":
