@@ -12,7 +12,7 @@ IoU 0.9 at all four times). A file the reader refuses (InputError) is *refused*;
 exception is *crashed*. Chromium's frames and the times are kept in ``--references``
 (default ``/tmp/bench-svg-references``), so a second run, e.g. ``--tree /tmp/old`` (another
 checkout of this repository, imported instead of the installed one), compares with the same
-frames at the same times.
+frames at the same times. Files are known by their folder and name there.
 
 Then each layer of each opened file is rendered alone at 512×512 at ``--timing-frames``
 times across its range: the mean wall time per layer-frame is what issue 14 calls mask
@@ -94,7 +94,7 @@ def iou(ours: np.ndarray, reference: np.ndarray) -> float:
 def reference_frames(path: Path, text: str, times: list[float], size: int, folder: Path) -> list[np.ndarray]:
     """Chromium's alpha ≥ 0.5 at ``times``, from the references folder or drawn now and kept there."""
     frames = []
-    shots = [folder / path.stem / f"{t:.6f}-{size}.png" for t in times]
+    shots = [folder / path.parent.name / path.stem / f"{t:.6f}-{size}.png" for t in times]
     if not all(shot.is_file() for shot in shots):
         shots[0].parent.mkdir(parents=True, exist_ok=True)
         for shot, alpha in zip(shots, chromium_coverage(text, times, (size, size))):
@@ -108,12 +108,13 @@ def sample_times(path: Path, document, folder: Path) -> list[float]:
     """0, ¼, ½, ¾ of the file's frame range, as the first run read it (kept in the references folder)."""
     record = folder / "times.json"
     known = json.loads(record.read_text()) if record.is_file() else {}
-    if path.name not in known:
+    name = f"{path.parent.name}/{path.name}"  # the SMIL and CSS spinner sets share file names
+    if name not in known:
         first, end = document.frame_range(FPS)
-        known[path.name] = [round((first + (end - first) * fraction) / FPS, 6) for fraction in FRACTIONS]
+        known[name] = [round((first + (end - first) * fraction) / FPS, 6) for fraction in FRACTIONS]
         folder.mkdir(parents=True, exist_ok=True)
         record.write_text(json.dumps(known, indent=1, sort_keys=True))
-    return known[path.name]
+    return known[name]
 
 
 def main() -> None:
