@@ -9,7 +9,8 @@ at 0 % or 100 % takes the element's own value, which may be an earlier animation
 written into the element's ``style`` attribute, so it wins over static rules as an
 animation does (``!important`` rules still win, as in browsers). Transforms are written
 as one resolved ``matrix()`` with ``transform-origin`` and ``transform-box`` folded in,
-since the rasterizer reads neither CSS transform units nor origins the way browsers do.
+since the rasterizer reads neither CSS transform units nor origins the way browsers do;
+a file whose CSS sets transforms but animates nothing is handled the same way.
 
 The default frame range (:meth:`CssAnimation.duration`) ends with the longest
 animation: delay + iterations × duration for a finite one, one full cycle
@@ -18,6 +19,7 @@ animation: delay + iterations × duration for a finite one, one full cycle
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
 from typing import Callable
 from xml.etree import ElementTree
@@ -37,6 +39,8 @@ from fluidymation.stages.vector.svg_reader import Animation
 
 _GEOMETRY = ("x", "y", "width", "height", "cx", "cy", "r", "rx", "ry")
 _TRANSFORM_DECLARATIONS = set(TRANSFORM_PROPERTIES) | {"transform-origin", "transform-box"}
+#: Words in a style sheet or ``style`` attribute that may make a file's CSS matter here.
+_CSS_TRIGGER = re.compile(r"animation|transform|translate|rotate|scale", re.IGNORECASE)
 _COLOR = ColorKind(paint=False)
 _BLACK = (0.0, 0.0, 0.0, 1.0)
 _NOT_PRESENTATION = {"translate", "rotate", "scale"}
@@ -65,16 +69,27 @@ class _Playing:
 
 
 def parse_css_animation(root: ElementTree.Element, source: str) -> CssAnimation | None:
-    """The file's CSS animations, or None when no ``animation`` property appears in it."""
+    """The file's CSS animations and CSS transforms, or None when it has neither (nor any that cannot play).
+
+    A file whose CSS only sets transforms (``transform``, ``rotate``, ``transform-origin``,
+    ...) comes here too: the rasterizer misreads CSS transform units and origins, so the
+    resolved matrices are written for it even when nothing moves.
+    """
     texts = [element.text or "" for element in root.iter() if local_name(element.tag) == "style"]
     texts += [element.get("style", "") for element in root.iter()]
-    if not any("animation" in text.lower() for text in texts):
+    if not (any(_CSS_TRIGGER.search(text) for text in texts)
+            or any(element.get("transform-origin") is not None for element in root.iter())):
         return None
-    return CssAnimation(root, source)
+    animation = CssAnimation(root, source)
+    if not animation.moves() and not animation.transforms() and not animation.unsupported:
+        return None
+    return animation
 
 
 class CssAnimation(Animation):
     """The CSS animations of an SVG file's tree; see the module's docstring for how a time is applied."""
+
+    language = "CSS"
 
     def __init__(self, root: ElementTree.Element, source: str):
         self.source = source
@@ -249,6 +264,14 @@ class CssAnimation(Animation):
 
     def duration(self):
         return max((run.timing.end() for playing in self._playing.values() for run in playing), default=0.0)
+
+    def moves(self) -> bool:
+        """Whether any CSS animation plays on an element."""
+        return bool(self._playing)
+
+    def transforms(self) -> bool:
+        """Whether CSS sets or animates any element's transform (its matrix is then written)."""
+        return bool(self._transformed)
 
 
 def _parse_attribute(name: str, text: str):

@@ -250,6 +250,8 @@ class Channel:
 class SmilAnimation(Animation):
     """A file's SMIL animations: parsed once, then applied to copies of its tree at any time."""
 
+    language = "SMIL"
+
     def __init__(self, source: str, animated: list[Animated], timings: list[Timing], ids: dict[str, int],
                  channels: list[Channel], unsupported: list[Unsupported]):
         self.source = source

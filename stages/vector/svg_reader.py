@@ -155,6 +155,8 @@ def _style_declarations(element: ElementTree.Element) -> list:
 class Animation(ABC):
     """What changes an SVG document over time (one animation language), parsed from its file's tree."""
 
+    #: The animation language, as a user names it (``SMIL``, ``CSS``).
+    language: str
     #: What it found in the file and cannot play faithfully.
     unsupported: tuple[Unsupported, ...] = ()
 
@@ -197,7 +199,7 @@ class SvgDocument(VectorDocument):
         self.root = root
         self.width, self.height = svg_size(root, str(path))
         self.layers = [VectorLayer(name, z) for z, name in enumerate(_layer_names(root))]
-        self.animations = tuple(animation for parse in ANIMATIONS if (animation := parse(root, str(path))))
+        self.animations = _animations(root, str(path))
         self.unsupported = undrawn(root) + tuple(item for animation in self.animations
                                                  for item in animation.unsupported)
 
@@ -207,11 +209,7 @@ class SvgDocument(VectorDocument):
         return 0, frames_in(max(animation.duration() for animation in self.animations), fps)
 
     def isolate(self, names, time_seconds) -> SvgFrame:
-        copies: dict[int, object] = {}
-        root = copy.deepcopy(self.root, copies)
-        for animation in self.animations:
-            animation.apply(lambda element: copies[id(element)], time_seconds)
-        return SvgFrame(_hide_other_layers(root, names), str(self.path))
+        return SvgFrame(_hide_other_layers(_at_time(self.root, self.animations, time_seconds), names), str(self.path))
 
 
 class SvgSequenceDocument(VectorDocument):
@@ -228,7 +226,10 @@ class SvgSequenceDocument(VectorDocument):
         first = load_svg(files[0])
         self.width, self.height = svg_size(first, str(files[0]))
         self.layers = [VectorLayer(name, z) for z, name in enumerate(_layer_names(first))]
-        self.unsupported = undrawn(first)
+        moving = [animation for animation in _animations(first, str(files[0])) if animation.duration() > 0]
+        self.unsupported = undrawn(first) + tuple(
+            Unsupported(f"{files[0].name}: {animation.language} animations", "the files of a sequence are stills: "
+                        "their animations are shown as at time 0") for animation in moving)
 
     def frame_range(self, fps):
         return 0, len(self.files)
@@ -238,7 +239,22 @@ class SvgSequenceDocument(VectorDocument):
         if not 0 <= frame < len(self.files):
             raise InputError(f"{self.path}: frame {frame} is outside the sequence (0 to {len(self.files) - 1})")
         path = self.files[frame]
-        return SvgFrame(_hide_other_layers(load_svg(path), names), str(path))
+        root = load_svg(path)  # its CSS transforms are resolved even when nothing moves
+        return SvgFrame(_hide_other_layers(_at_time(root, _animations(root, str(path)), 0.0), names), str(path))
+
+
+def _animations(root: ElementTree.Element, source: str) -> tuple[Animation, ...]:
+    """The animations the file holds, one per parser of :data:`ANIMATIONS` that finds its kind."""
+    return tuple(animation for parse in ANIMATIONS if (animation := parse(root, source)))
+
+
+def _at_time(root: ElementTree.Element, animations: tuple[Animation, ...], time_seconds: float) -> ElementTree.Element:
+    """A copy of ``root`` with every animation applied at ``time_seconds``."""
+    copies: dict[int, object] = {}
+    copied = copy.deepcopy(root, copies)
+    for animation in animations:
+        animation.apply(lambda element: copies[id(element)], time_seconds)
+    return copied
 
 
 def open_svg(path: Path, *, split: tuple[str, ...] = (), fps: float | None = None) -> SvgDocument:
@@ -255,8 +271,8 @@ def open_svg_sequence(pattern: Path, *, split: tuple[str, ...] = (), fps: float 
     return SvgSequenceDocument(str(pattern), sequence_files(pattern), fps or DEFAULT_FPS)
 
 
-SVG_READER = Reader("svg", 3, (".svg",), open_svg)
-SEQUENCE_READER = Reader("svg-sequence", 2, (".svg",), open_svg_sequence, sequence=True)
+SVG_READER = Reader("svg", 4, (".svg",), open_svg)
+SEQUENCE_READER = Reader("svg-sequence", 3, (".svg",), open_svg_sequence, sequence=True)
 
 
 def sequence_files(pattern: Path) -> list[Path]:

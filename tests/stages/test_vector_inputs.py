@@ -225,3 +225,23 @@ def test_wave_example_agrees_with_lottie_rendering(layer):
     document = open_document(path)
     for frame in (0, 12, 30):
         assert soft_iou(coverage(document, [layer], frame), lottie_reference(path, layer, frame)) >= 0.99
+
+
+def test_svg_sequence_files_have_their_css_transforms_resolved(tmp_path):
+    """cairosvg alone reads rotate(90deg) as no rotation; the CSS timeline resolves it in every file."""
+    for index in range(2):
+        (tmp_path / f"f{index}.svg").write_text(
+            '<svg xmlns="http://www.w3.org/2000/svg" width="40" height="40"><style>rect{transform:rotate(90deg);'
+            f'transform-origin:20px 20px}}</style><g id="bar"><rect y="16" width="{10 + 10 * index}" height="8"/>'
+            '</g></svg>')
+    document = open_document(tmp_path / "f%d.svg", fps=24)
+    assert not document.unsupported
+    turned = coverage(document, ["bar"], 1)
+    assert turned[:20, 16:24].sum() == pytest.approx(160) and turned.sum() == pytest.approx(160)
+
+
+def test_svg_sequence_files_with_animations_are_listed(tmp_path):
+    (tmp_path / "f0.svg").write_text('<svg xmlns="http://www.w3.org/2000/svg" width="10" height="10"><rect width="5" '
+                                     'height="5"><animate attributeName="width" to="10" dur="1s"/></rect></svg>')
+    assert [(item.element, item.message) for item in open_document(tmp_path / "f%d.svg", fps=24).unsupported] == [
+        ("f0.svg: SMIL animations", "the files of a sequence are stills: their animations are shown as at time 0")]
