@@ -1,0 +1,70 @@
+"""Regenerate the README's example videos and stills in docs/examples/ from the bundled examples.
+
+Run from the repository: ``.venv/bin/python docs/examples/make_examples.py [NAME ...]``
+(names: wave, blob, squiggle, ablate-blob; default all). Each example scene is rendered
+with the installed ``fluidymation`` into its own ``examples/<name>/out/``; its video is
+copied here and five of its frames are laid side by side, 4 px apart, as ``<name>.jpg``.
+``ablate-blob`` runs ``fluidymation ablate`` on the blob layer and keeps one frame of its
+side-by-side video.
+"""
+
+from __future__ import annotations
+
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import imageio.v3 as iio
+import numpy as np
+
+REPOSITORY = Path(__file__).resolve().parents[2]
+HERE = Path(__file__).resolve().parent
+#: Which frames of each example's video make its still.
+STILL_FRAMES = {"wave": (0, 12, 24, 36, 47), "blob": (0, 12, 24, 36, 47), "squiggle": (2, 8, 14, 20, 23)}
+ABLATION_FRAME = 24
+GAP = 4
+
+
+def fluidymation(*arguments: str) -> None:
+    subprocess.run([sys.executable, "-m", "fluidymation", *arguments], cwd=REPOSITORY, check=True)
+
+
+def side_by_side(frames: list[np.ndarray]) -> np.ndarray:
+    """Frames in a row, ``GAP`` white pixels apart."""
+    height = frames[0].shape[0]
+    gap = np.full((height, GAP, 3), 255, np.uint8)
+    row = [frames[0]]
+    for frame in frames[1:]:
+        row += [gap, frame]
+    return np.concatenate(row, axis=1)
+
+
+def make_example(name: str) -> None:
+    fluidymation("render", f"examples/{name}/scene.yaml")
+    video = REPOSITORY / "examples" / name / "out" / f"{name}.mp4"
+    shutil.copyfile(video, HERE / f"{name}.mp4")
+    frames = iio.imread(video, plugin="pyav")
+    iio.imwrite(HERE / f"{name}.jpg", side_by_side([frames[index] for index in STILL_FRAMES[name]]), quality=90)
+
+
+def make_ablation() -> None:
+    fluidymation("ablate", "examples/blob/scene.yaml", "--layer", "blob")
+    video = REPOSITORY / "examples" / "blob" / "out" / "ablate" / "blob.mp4"
+    shutil.copyfile(video, HERE / "ablate-blob.mp4")
+    iio.imwrite(HERE / "ablate-blob.jpg", iio.imread(video, plugin="pyav", index=ABLATION_FRAME), quality=90)
+
+
+def main() -> None:
+    names = sys.argv[1:] or [*STILL_FRAMES, "ablate-blob"]
+    for name in names:
+        if name == "ablate-blob":
+            make_ablation()
+        elif name in STILL_FRAMES:
+            make_example(name)
+        else:
+            sys.exit(f"unknown example {name!r}: choose from {', '.join([*STILL_FRAMES, 'ablate-blob'])}")
+
+
+if __name__ == "__main__":
+    main()
