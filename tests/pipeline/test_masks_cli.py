@@ -61,8 +61,8 @@ def test_check_prints_the_resolved_scene(cli):
     assert "reader:  lottie v2, renderer thorvg v1" in out
 
 
-@pytest.mark.parametrize("example,line", [("blob", "reader:  svg v3, renderer cairosvg v1"),
-                                          ("squiggle", "reader:  svg-sequence v2, renderer cairosvg v1")])
+@pytest.mark.parametrize("example,line", [("blob", "reader:  svg v4, renderer cairosvg v1"),
+                                          ("squiggle", "reader:  svg-sequence v3, renderer cairosvg v1")])
 def test_check_names_the_reader_and_renderer(cli, example, line):
     code, out, err = cli("check", EXAMPLES / example / "scene.yaml")
     assert code == 0, err
