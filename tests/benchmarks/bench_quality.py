@@ -1,0 +1,474 @@
+"""Quality benchmark (issue 15): scenes with known motion, stylized with every built-in medium.
+
+Run: ``NUMBA_CACHE_DIR=.numba-cache .venv/bin/python tests/benchmarks/bench_quality.py
+[--scenes translation still ...] [--media watercolor-bloom ...] [--write-docs] [--record-baseline]``.
+
+Each scene is a 128×128 layer of 12 frames drawn analytically here (soft 1-px edges),
+stylized with the stylizer's defaults (configs/fluidymation.yaml, the guides' defaults)
+from a 96×96×12 built-in exemplar (generated once into the user cache); scenes with a
+still region are rendered a second time with ``w_temp: 0``. The metrics
+(:mod:`fluidymation.quality`) are computed on the output and, where they have one, on
+the exemplar's own frames and masks; each cell is checked against issue 15's threshold
+(P/F). ``--write-docs`` writes the table, the command, the date and the load average to
+docs/quality.md and one contact sheet per scene to docs/quality/. ``--record-baseline``
+stores this run's texture fidelity in docs/quality/baseline.json: the "no worse than
+today" reference later runs are checked against.
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import datetime
+import json
+import os
+import shlex
+import sys
+import tempfile
+import time
+from pathlib import Path
+from typing import Callable, NamedTuple
+
+import numpy as np
+from PIL import Image
+
+from fluidymation import quality
+from fluidymation.pipeline import paths
+from fluidymation.pipeline.parameters import default_params
+from fluidymation.pipeline.presets import resolve_params
+from fluidymation.pipeline.stylizers import get_stylizer
+from fluidymation.stages import exemplar_builtin, exemplar_store, guides, stylize
+
+ROOT = Path(__file__).resolve().parents[2]
+DOCS = ROOT / "docs" / "quality.md"
+SHEETS = ROOT / "docs" / "quality"
+BASELINE = SHEETS / "baseline.json"
+SIZE = 128
+FRAMES = 12
+EXEMPLAR_SIZE = 96
+MEDIA = ("watercolor-bloom", "watercolor-dry", "watercolor-backrun", "crumble")
+#: fewest pixels (over all frame pairs) a still region or moving band needs to be measured
+MIN_REGION = 200
+FIDELITY_TOLERANCE = 1.05
+#: bands of the edge-gradient profiles listed in docs/quality.md
+CURVE_BANDS = 20
+PAPER = np.array(exemplar_builtin.PAPER_COLOUR, np.float32)
+
+_YY, _XX = np.mgrid[:SIZE, :SIZE].astype(np.float64) + 0.5
+
+
+def _soft(distance: np.ndarray) -> np.ndarray:
+    """Coverage of a shape from its signed distance (px, positive inside): a 1-px linear edge."""
+    return np.clip(distance + 0.5, 0.0, 1.0).astype(np.float32)
+
+
+def _ellipse(cx, cy, a, b, angle=0.0) -> np.ndarray:
+    """Soft ellipse with semi-axes a (along ``angle``, radians) and b; first-order distance to its edge."""
+    u = (_XX - cx) * np.cos(angle) + (_YY - cy) * np.sin(angle)
+    v = -(_XX - cx) * np.sin(angle) + (_YY - cy) * np.cos(angle)
+    g = np.maximum(np.hypot(u / a, v / b), 1e-6)
+    return _soft((1.0 - g) * g / np.maximum(np.hypot(u / a**2, v / b**2), 1e-9))
+
+
+def _capsule(x0, x1, y, radius) -> np.ndarray:
+    """Soft horizontal capsule: the points within ``radius`` of the segment (x0, y)–(x1, y)."""
+    return _soft(radius - np.hypot(_XX - np.clip(_XX, x0, x1), _YY - y))
+
+
+def _rotation(cx, cy, angle) -> np.ndarray:
+    """Displacement (H, W, 2) of a rotation by ``angle`` about (cx, cy)."""
+    x, y = _XX - cx, _YY - cy
+    return np.stack([x * np.cos(angle) - y * np.sin(angle) - x, x * np.sin(angle) + y * np.cos(angle) - y], axis=-1)
+
+
+def _scaling(cx, cy, factor) -> np.ndarray:
+    """Displacement (H, W, 2) of a scaling by ``factor`` about (cx, cy)."""
+    return np.stack([(_XX - cx) * (factor - 1.0), (_YY - cy) * (factor - 1.0)], axis=-1)
+
+
+def ratio(numerator: float, denominator: float) -> float:
+    """numerator / denominator as numpy divides (inf over 0, nan for 0 / 0 or with a nan)."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return float(np.float64(numerator) / denominator)
+
+
+def _uniform(dx, dy) -> np.ndarray:
+    return np.broadcast_to(np.array([dx, dy], np.float64), (SIZE, SIZE, 2))
+
+
+class Scene(NamedTuple):
+    """A layer with known motion: ``coverage(t)`` (H, W) and ``displacement(t)`` (H, W, 2), the shape's
+    motion in px from frame t − 1 to frame t (t ≥ 1)."""
+
+    name: str
+    description: str
+    coverage: Callable[[int], np.ndarray]
+    displacement: Callable[[int], np.ndarray]
+
+
+def _grow_end(t):
+    return 36.0 + 5.0 * t
+
+
+def _grown_stretch(t):
+    """Anchored growth: the capsule's straight part and right cap stretch away from the fixed left cap."""
+    factor = (_grow_end(t) - 32.0) / (_grow_end(t - 1) - 32.0)
+    return np.stack([np.where(_XX > 32.0, (_XX - 32.0) * (factor - 1.0), 0.0), np.zeros_like(_YY)], axis=-1)
+
+
+SCENES = (
+    Scene("translation", "ellipse 60×44 px tilted 20°, moving (2.5, 1) px/frame",
+          lambda t: _ellipse(50 + 2.5 * t, 58 + 1.0 * t, 30, 22, np.radians(20)), lambda t: _uniform(2.5, 1.0)),
+    Scene("rotation", "ellipse 88×48 px turning 4°/frame about its centre",
+          lambda t: _ellipse(64, 64, 44, 24, np.radians(4 * t)), lambda t: _rotation(64, 64, np.radians(4))),
+    Scene("scale", "ellipse 56×40 px growing uniformly to 1.6× about its centre",
+          lambda t: _ellipse(64, 64, 28 * 1.6 ** (t / 11), 20 * 1.6 ** (t / 11)),
+          lambda t: _scaling(64, 64, 1.6 ** (1 / 11))),
+    Scene("growth", "capsule 48 px tall, left end fixed, right end moving 5 px/frame (52→107 px wide)",
+          lambda t: _capsule(32, _grow_end(t), 64, 24), _grown_stretch),
+    Scene("shrink", "ellipse 88×64 px shrinking uniformly to 0.6× about its centre",
+          lambda t: _ellipse(64, 64, 44 * 0.6 ** (t / 11), 32 * 0.6 ** (t / 11)),
+          lambda t: _scaling(64, 64, 0.6 ** (1 / 11))),
+    Scene("still", "ellipse 80×56 px tilted 15°, not moving",
+          lambda t: _ellipse(64, 64, 40, 28, np.radians(15)), lambda t: _uniform(0.0, 0.0)),
+    Scene("two shapes", "one layer: a still disk (r 20 px) and an ellipse 32×44 px moving (2, 0.5) px/frame",
+          lambda t: np.maximum(_ellipse(30, 64, 20, 20), _ellipse(78 + 2.0 * t, 60 + 0.5 * t, 16, 22)),
+          lambda t: np.where((_XX < 54)[..., None], 0.0, _uniform(2.0, 0.5))),
+)
+
+#: the issue's thresholds, as printed under the table
+THRESHOLDS = (
+    ("profile", "edge-gradient profile peak/median (bands 5–40 px) ≤ 1.1 × the exemplar's"),
+    ("blocks", "blockiness ≤ 1.05"),
+    ("C last/1st", "local contrast, last frame / first frame ≥ 0.9"),
+    ("C/ex", "local contrast (mean over frames) / the exemplar's within 0.85–1.15"),
+    ("still/wt0", "still-region change ≤ 0.3 × that of the w_temp: 0 render"),
+    ("still/ex", "still-region change ≤ 2 × the exemplar's stationary paint's"),
+    ("band/still", "moving-band change ≥ 2 × the still-region change"),
+    ("IoU", "IoU of output alpha with the masks (worst frame) ≥ 0.98"),
+    ("fidelity", f"texture fidelity ≤ {FIDELITY_TOLERANCE} × the recorded baseline (docs/quality/baseline.json)"),
+)
+
+
+class Exemplar(NamedTuple):
+    """A built-in medium: its frames and masks, its stylize source and its own figures."""
+
+    rgb: np.ndarray
+    mask: np.ndarray
+    source: exemplar_store.Source
+    figures: dict
+
+
+def profile_curve(profile: np.ndarray, counts: np.ndarray) -> np.ndarray:
+    """Bands 1..CURVE_BANDS of a gradient profile over its median across the fitting bands (docs/quality.md)."""
+    fitting = quality.fitting_bands(counts)
+    return profile[1:CURVE_BANDS + 1] / np.median(profile[fitting.start:fitting.stop])
+
+
+def exemplar_figures(rgb, mask, flow) -> dict:
+    """The metrics that have a value on the exemplar's own frames and masks."""
+    profile, counts = quality.gradient_profile(rgb, mask)
+    peak, band = quality.profile_peak_ratio(profile, counts)
+    contrast = [quality.local_contrast(frame, m) for frame, m in zip(rgb, mask)]
+    changes = [quality.change(a, b) for a, b in zip(rgb, rgb[1:])]
+    stationary = [quality.exemplar_stationary(mask[t - 1], mask[t], flow[t]) for t in range(1, len(rgb))]
+    bands = [quality.moving_band(mask[t - 1], mask[t]) for t in range(1, len(rgb))]
+    still = quality.pooled_mean(changes, stationary, min_pixels=MIN_REGION)
+    return {"profile": peak, "profile_band": band, "profile_curve": profile_curve(profile, counts),
+            "blockiness": quality.blockiness(rgb, mask),
+            "contrast_last_first": contrast[-1] / contrast[0], "contrast": float(np.mean(contrast)),
+            "still": still, "band_still": ratio(quality.pooled_mean(changes, bands, min_pixels=MIN_REGION), still)}
+
+
+def load_exemplar(medium: str, workdir: Path, guide_params: guides.Params) -> Exemplar:
+    """The medium at the benchmark's size (from the user cache) with its guides, as the pipeline makes them."""
+    params = resolve_params(medium, size=(EXEMPLAR_SIZE, EXEMPLAR_SIZE), frames=FRAMES)
+    made = exemplar_builtin.make_builtin_exemplar(params, cache_dir=paths.exemplar_cache_dir())
+    cache = guides.compute_guides(lambda j: made.mask[j], FRAMES, params=guide_params,
+                                  cache_dir=workdir / f"{medium}-source", given_flow=lambda j: made.flow[j])
+    return Exemplar(made.rgb, made.mask, exemplar_store.in_memory(made.rgb, cache),
+                    exemplar_figures(made.rgb, made.mask, made.flow))
+
+
+def render(scene: Scene, exemplar: Exemplar, params: stylize.Params, guide_params: guides.Params,
+           cache_dir: Path) -> np.ndarray:
+    """The stylized layer, (T, H, W, 4)."""
+    frames = stylize.stylize_sequence(scene.coverage, FRAMES, exemplar.source, params=params,
+                                      guide_params=guide_params, cache_dir=cache_dir)
+    return np.stack([frame.rgba for frame in frames])
+
+
+def measure(scene: Scene, exemplar: Exemplar, params: stylize.Params, guide_params: guides.Params,
+            workdir: Path) -> tuple[dict, np.ndarray]:
+    """Render the scene (and its ``w_temp: 0`` twin when it has a still region); return its figures and frames."""
+    masks = [scene.coverage(t) for t in range(FRAMES)]
+    output = render(scene, exemplar, params, guide_params, workdir / "default")
+    still = [quality.still_region(masks[t - 1], masks[t], scene.displacement(t)) for t in range(1, FRAMES)]
+    bands = [quality.moving_band(masks[t - 1], masks[t]) for t in range(1, FRAMES)]
+    changes = [quality.change(a, b) for a, b in zip(output, output[1:])]
+    profile, counts = quality.gradient_profile(output, masks)
+    peak, band = quality.profile_peak_ratio(profile, counts)
+    contrast = [quality.local_contrast(frame, mask) for frame, mask in zip(output, masks)]
+    still_change = quality.pooled_mean(changes, still, min_pixels=MIN_REGION)
+    independent = float("nan")
+    if np.isfinite(still_change):
+        without = render(scene, exemplar, dataclasses.replace(params, w_temp=0.0), guide_params, workdir / "w_temp0")
+        independent = quality.pooled_mean([quality.change(a, b) for a, b in zip(without, without[1:])], still)
+    figures = {
+        "profile": peak, "profile_band": band, "profile_curve": profile_curve(profile, counts),
+        "blockiness": quality.blockiness(output, masks),
+        "contrast_last_first": contrast[-1] / contrast[0], "contrast": float(np.mean(contrast)),
+        "still": still_change, "still_w_temp0": independent,
+        "band_still": ratio(quality.pooled_mean(changes, bands, min_pixels=MIN_REGION), still_change),
+        "iou": min(quality.iou(frame[..., 3], mask) for frame, mask in zip(output, masks)),
+        "fidelity": quality.texture_fidelity(output, masks, exemplar.rgb, exemplar.mask),
+    }
+    return figures, output
+
+
+def verdicts(figures: dict, reference: dict, baseline: float | None) -> dict:
+    """Issue 15's pass/fail per metric (None where the metric does not apply)."""
+
+    def check(value, passes):
+        return None if value is None or np.isnan(value) else bool(passes(value))
+
+    return {
+        "profile": check(figures["profile"], lambda v: v <= 1.1 * reference["profile"]),
+        "blocks": check(figures["blockiness"][0], lambda v: v <= 1.05),
+        "C last/1st": check(figures["contrast_last_first"], lambda v: v >= 0.9),
+        "C/ex": check(ratio(figures["contrast"], reference["contrast"]), lambda v: 0.85 <= v <= 1.15),
+        "still/wt0": check(ratio(figures["still"], figures["still_w_temp0"]), lambda v: v <= 0.3),
+        "still/ex": check(ratio(figures["still"], reference["still"]), lambda v: v <= 2.0),
+        "band/still": check(figures["band_still"], lambda v: v >= 2.0),
+        "IoU": check(figures["iou"], lambda v: v >= 0.98),
+        "fidelity": None if baseline is None else check(figures["fidelity"],
+                                                        lambda v: v <= FIDELITY_TOLERANCE * baseline),
+    }
+
+
+COLUMNS = ("scene", "profile", "blocks", "C last/1st", "C/ex", "still Δ", "still/wt0", "still/ex", "band/still",
+           "IoU", "fidelity")
+
+
+def _number(value, digits=2) -> str:
+    return "n/a" if value is None or np.isnan(value) else f"{value:.{digits}f}"
+
+
+def _cell(text: str, verdict) -> str:
+    return text if verdict is None else f"{text} {'P' if verdict else 'F'}"
+
+
+def exemplar_row(medium: str, figures: dict) -> list[str]:
+    return [f"{medium} (exemplar)", f"{_number(figures['profile'])}@{figures['profile_band']}",
+            f"{figures['blockiness'][0]:.3f}", _number(figures["contrast_last_first"]), "1",
+            _number(1e3 * figures["still"]), "", "1", _number(figures["band_still"]), "", ""]
+
+
+def scene_row(name: str, figures: dict, reference: dict, baseline: float | None) -> list[str]:
+    verdict = verdicts(figures, reference, baseline)
+    fidelity = _number(figures["fidelity"], 4) + ("" if baseline is None else f" ({baseline:.4f})")
+    return [name,
+            _cell(f"{_number(figures['profile'])}@{figures['profile_band']}", verdict["profile"]),
+            _cell(f"{figures['blockiness'][0]:.3f}", verdict["blocks"]),
+            _cell(_number(figures["contrast_last_first"]), verdict["C last/1st"]),
+            _cell(_number(ratio(figures["contrast"], reference["contrast"])), verdict["C/ex"]),
+            _number(1e3 * figures["still"]) + f" / {_number(1e3 * figures['still_w_temp0'])}",
+            _cell(_number(ratio(figures["still"], figures["still_w_temp0"])), verdict["still/wt0"]),
+            _cell(_number(ratio(figures["still"], reference["still"])), verdict["still/ex"]),
+            _cell(_number(figures["band_still"]), verdict["band/still"]),
+            _cell(_number(figures["iou"], 3), verdict["IoU"]),
+            _cell(fidelity, verdict["fidelity"])]
+
+
+def text_table(rows: list[list[str]]) -> str:
+    widths = [max(len(row[i]) for row in [list(COLUMNS)] + rows) for i in range(len(COLUMNS))]
+    lines = ["  ".join(cell.ljust(width) for cell, width in zip(row, widths)) for row in [list(COLUMNS)] + rows]
+    return "\n".join(lines)
+
+
+def markdown_table(rows: list[list[str]]) -> str:
+    lines = ["| " + " | ".join(COLUMNS) + " |", "|" + "---|" * len(COLUMNS)]
+    lines += ["| " + " | ".join(cell.replace("|", "\\|") for cell in row) + " |" for row in rows]
+    return "\n".join(lines)
+
+
+def _over_paper(rgba: np.ndarray) -> np.ndarray:
+    alpha = rgba[..., 3:4]
+    return rgba[..., :3] * alpha + PAPER * (1 - alpha)
+
+
+def _tile(image: np.ndarray) -> np.ndarray:
+    """An RGB image in [0, 1] centred on a SIZE×SIZE paper tile."""
+    tile = np.broadcast_to(PAPER, (SIZE, SIZE, 3)).copy()
+    top, left = (SIZE - image.shape[0]) // 2, (SIZE - image.shape[1]) // 2
+    tile[top:top + image.shape[0], left:left + image.shape[1]] = image
+    return tile
+
+
+def contact_sheet(scene: Scene, rows: list[tuple[np.ndarray, np.ndarray]], path: Path) -> None:
+    """One row per medium: exemplar middle frame; output frames first, middle and last; the change into
+    the middle frame inside both frames' masks (×5, dark = change; paper elsewhere)."""
+    middle = FRAMES // 2
+    both = quality.inside(scene.coverage(middle - 1)) & quality.inside(scene.coverage(middle))
+    lines = []
+    for exemplar_rgb, output in rows:
+        difference = 1.0 - np.clip(5.0 * quality.change(output[middle - 1], output[middle]), 0, 1)
+        difference = np.where(both[..., None], difference[..., None], PAPER)
+        lines.append(np.concatenate([_tile(exemplar_rgb[middle]), _over_paper(output[0]), _over_paper(output[middle]),
+                                     _over_paper(output[-1]), difference], axis=1))
+    sheet = (np.clip(np.concatenate(lines, axis=0), 0, 1) * 255 + 0.5).astype(np.uint8)
+    Image.fromarray(sheet).save(path, optimize=True)
+
+
+def sheet_name(scene: Scene) -> str:
+    return scene.name.replace(" ", "-") + ".png"
+
+
+def curves_table(results) -> str:
+    """Markdown: every profile curve (exemplar and scenes), one row each."""
+    lines = ["| | " + " | ".join(str(k) for k in range(1, CURVE_BANDS + 1)) + " |", "|---|" + "---|" * CURVE_BANDS]
+    for medium, reference, measured in results:
+        for name, figures in [("exemplar", reference)] + measured:
+            values = " | ".join("" if np.isnan(v) else f"{v:.2f}" for v in figures["profile_curve"])
+            lines.append(f"| {medium} {name} | {values} |")
+    return "\n".join(lines)
+
+
+def write_docs(command: str, loads: tuple, started: str, seconds: float, rows: list[list[str]], results,
+               scenes, media) -> None:
+    sheets = "\n".join(f"- {scene.name} ({scene.description}): ![{scene.name}](quality/{sheet_name(scene)})"
+                       for scene in scenes)
+    DOCS.write_text(f"""## Quality benchmark (issue 15)
+
+Written by `tests/benchmarks/bench_quality.py --write-docs`; do not edit by hand.
+
+Command: `{command}`. Run {started} in {seconds:.0f} s; load average
+{loads[0]:.2f} at the start, {loads[1]:.2f} at the end (2 cores).
+
+Each scene is a {SIZE}×{SIZE} layer of {FRAMES} frames with soft 1-px edges, drawn analytically by the
+benchmark, stylized with the defaults of configs/fluidymation.yaml and the guides' defaults from a
+{EXEMPLAR_SIZE}×{EXEMPLAR_SIZE}×{FRAMES} built-in exemplar of each medium (seed and colour of
+configs/exemplars.yaml). Media: {', '.join(media)}.
+
+{markdown_table(rows)}
+
+P/F: issue 15's thresholds; n/a: the scene has no such region (no still region: the still-region
+and band/still figures; no moving edge: the band). The exemplar row of each medium holds the
+exemplar's own values, computed on its frames and masks.
+
+{chr(10).join(f'- **{name}**: {text}' for name, text in THRESHOLDS)}
+
+### What the figures are (`fluidymation/quality.py`)
+
+Luminance is the mean of R, G and B (sRGB in [0, 1]); a pixel is inside where the mask's
+coverage is ≥ 0.5; the edge distance of an inside pixel is its Euclidean distance to the
+nearest outside pixel centre (1 next to the edge).
+
+- **profile**: the mean luminance-gradient magnitude (central differences) in 1-px bands of
+  edge distance (band k: k ≤ distance < k + 1), over all frames; printed is max/median over
+  bands 5–40, clipped to the bands that hold ≥ 100 pixels (stopping at the first that does
+  not), and `@` the band of the maximum. A seam ring parallel to the edge is a peak.
+- **blocks**: for each axis, |Δ luminance| of adjacent pixel pairs with both pixels inside the
+  mask eroded by 2 px, pooled over all frames; a pair straddles boundary i (between pixels
+  i − 1 and i). Printed is the larger of mean |Δ| over even boundaries / mean |Δ| over odd ones
+  and its inverse, over both axes. 1.0: no grid. The blocks the stylizer makes are 2 px (their
+  pattern at period 4 is the period-2 one). The figure's noise on one image is about ±4 %: the
+  exemplars' frames (nearly alike, so about one image's worth) give 1.02–1.03 for the
+  watercolors; crumble's exemplar has a real period-2 structure along y (1.16).
+- **C last/1st**, **C/ex**: local contrast is the mean 5×5 standard deviation of luminance
+  inside the mask eroded by 3 px; the last frame's over the first's, and the mean over frames
+  over the exemplar's mean over its frames (in its masks).
+- **still Δ** (×10⁻³): the mean over R, G, B of |frame t − frame t − 1|, pooled over the pixels
+  of the still region of every pair: inside both masks ≥ 2 px from the edge in both, whose edge
+  distance changes by < 0.1 px and whose known displacement (the scene's own motion) is
+  < 0.1 px. Beside it (`/`) the same on the `w_temp: 0` render. Measured only with
+  ≥ {MIN_REGION} pixels in all. The exemplar's: its pixels in its mask in both frames with
+  exact flow < 0.05 px/frame, eroded by 2 px.
+- **still/wt0**, **still/ex**: still Δ over the `w_temp: 0` render's, and over the exemplar's.
+- **band/still**: the change pooled over the moving band (inside both masks, ≤ 10 px from the
+  edge in the later frame, edge distance changed by ≥ 0.5 px) over the still Δ. The exemplar's:
+  the same band on its masks over its stationary change.
+- **IoU**: output alpha ≥ 0.5 against the mask ≥ 0.5, the worst frame. The stylizer's alpha
+  is the target coverage, so this guards against a regression rather than measuring synthesis.
+- **fidelity**: 2000 5×5 output patches lying wholly inside the masks, drawn with a fixed
+  seed from all frames, each against every exemplar patch centred in the exemplar's masks
+  (exact nearest neighbour): the mean RMS colour difference per pixel and channel. 0: the
+  output is made of exemplar patches. In parentheses the baseline recorded with
+  `--record-baseline` (the stylizer before issue 15's item 2).
+
+### Edge-gradient profiles
+
+The profile behind the **profile** column: mean luminance-gradient magnitude in band k (k ≤ edge
+distance < k + 1) for k = 1–{CURVE_BANDS}, over its median across the bands the figure uses. The
+target guides' border/interior split (guides `border_width` 10 px) lies at an edge distance of
+about 9.5–10 px in these scenes.
+
+{curves_table(results)}
+
+### Contact sheets
+
+Per scene, one row per medium: the exemplar's middle frame, the output's first, middle and last
+frames over paper, and the change into the middle frame where both frames are inside the mask
+(×5, dark = change).
+
+{sheets}
+""")
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--scenes", nargs="+", default=[s.name for s in SCENES], choices=[s.name for s in SCENES],
+                        metavar="SCENE", help=f"scenes to run (default all: {', '.join(s.name for s in SCENES)})")
+    parser.add_argument("--media", nargs="+", default=list(MEDIA), choices=MEDIA, metavar="MEDIUM",
+                        help=f"built-in exemplars (default all: {', '.join(MEDIA)})")
+    parser.add_argument("--write-docs", action="store_true", help="write docs/quality.md and docs/quality/*.png")
+    parser.add_argument("--record-baseline", action="store_true",
+                        help="store this run's texture fidelity as the baseline (docs/quality/baseline.json)")
+    args = parser.parse_args()
+    scenes = [s for s in SCENES if s.name in args.scenes]
+    command = "NUMBA_CACHE_DIR=.numba-cache .venv/bin/python " + shlex.join(["tests/benchmarks/bench_quality.py",
+                                                                             *sys.argv[1:]])
+    started = datetime.datetime.now().strftime("%Y-%m-%d %H:%M")
+    clock, load_start = time.perf_counter(), os.getloadavg()
+    print(f"{command}\nload average {load_start[0]:.2f} {load_start[1]:.2f} {load_start[2]:.2f}", flush=True)
+    params = default_params(get_stylizer("fluidymation"))
+    guide_params = guides.Params()
+    baseline = json.loads(BASELINE.read_text()) if BASELINE.is_file() else {}
+    results, sheet_rows = [], {s.name: [] for s in scenes}
+    with tempfile.TemporaryDirectory() as workdir:
+        workdir = Path(workdir)
+        for medium in args.media:
+            exemplar = load_exemplar(medium, workdir, guide_params)
+            results.append((medium, exemplar.figures, []))
+            for scene in scenes:
+                begun = time.perf_counter()
+                figures, output = measure(scene, exemplar, params, guide_params, workdir / medium / scene.name)
+                results[-1][2].append((scene.name, figures))
+                sheet_rows[scene.name].append((exemplar.rgb, output))
+                print(f"{medium} / {scene.name}: {time.perf_counter() - begun:.1f} s", file=sys.stderr, flush=True)
+    if args.record_baseline:
+        for medium, _, measured in results:
+            baseline.setdefault(medium, {}).update({name: figures["fidelity"] for name, figures in measured})
+        SHEETS.mkdir(parents=True, exist_ok=True)
+        BASELINE.write_text(json.dumps(baseline, indent=1, sort_keys=True) + "\n")
+    rows = []
+    for medium, reference, measured in results:
+        rows.append(exemplar_row(medium, reference))
+        rows += [scene_row(f"  {name}", figures, reference, baseline.get(medium, {}).get(name))
+                 for name, figures in measured]
+    loads = (load_start[0], os.getloadavg()[0])
+    seconds = time.perf_counter() - clock
+    print(text_table(rows))
+    print("\nthresholds (issue 15, item 2):")
+    for name, text in THRESHOLDS:
+        print(f"  {name:10s} {text}")
+    print(f"\n{seconds:.0f} s; load average {loads[0]:.2f} -> {loads[1]:.2f}")
+    if args.write_docs:
+        SHEETS.mkdir(parents=True, exist_ok=True)
+        for scene in scenes:
+            contact_sheet(scene, sheet_rows[scene.name], SHEETS / sheet_name(scene))
+        write_docs(command, loads, started, seconds, rows, results, scenes, args.media)
+
+
+if __name__ == "__main__":
+    main()
