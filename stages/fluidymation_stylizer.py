@@ -28,6 +28,7 @@ class FluidymationStylizer(Stylizer):
     ablation = (
         ("full", ()),
         ("no bound", ("w_bound",)),
+        ("no edge", ("w_edge",)),
         ("no dir", ("w_dir",)),
         ("no ext", ("w_ext",)),
         ("no temp", ("w_temp",)),

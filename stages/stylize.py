@@ -4,7 +4,7 @@ Every target frame is synthesized from patches of the whole moving exemplar
 (paper section 3, appendix B; thesis chapter 3, sections 4.2–4.4; ALGORITHM.md) with the
 patch distance
 
-    |rgb|² + w_bound |shape|² + w_ext (|ext+|² + |ext−|²) + m(q) w_temp |temp|²
+    |rgb|² + w_bound |shape|² + w_edge |df|² + w_ext (|ext+|² + |ext−|²) + m(q) w_temp |temp|²
     + w_dir |tan(S_dir + θ − T_dir)| + w_uni λ Ω/ω*
 
 (ext± divided by ``ext_unit``; ext+ and ext− swapped where source and target flows are
@@ -44,12 +44,12 @@ from fluidymation.stages import guides
 from fluidymation.stages.exemplar_store import Source, StoredSource, border_clamped, concatenate
 
 NAME = "stylize"
-VERSION = 2
+VERSION = 3
 
 #: Target guide channels, in order; the source compares shape, ext+, ext− and its colour (as S_temp).
-_GUIDES = ("shape", "ext_plus", "ext_minus", "temp_r", "temp_g", "temp_b")
-_OPPOSITE = np.array([0, 2, 1, 3, 4, 5], np.int64)
-_WEIGHT_MAP = np.array([-1, -1, -1, 0, 0, 0], np.int64)
+_GUIDES = ("shape", "edge", "ext_plus", "ext_minus", "temp_r", "temp_g", "temp_b")
+_OPPOSITE = np.array([0, 1, 3, 2, 4, 5, 6], np.int64)
+_WEIGHT_MAP = np.array([-1, -1, -1, -1, 0, 0, 0], np.int64)
 
 
 @dataclass(frozen=True)
@@ -60,9 +60,10 @@ class Params:
     ----------
     patch_size : int
         n, odd.
-    w_bound, w_ext, w_dir, w_temp, w_uni : float
-        Weights of the shape, motion-extent, orientation, temporal and uniformity terms;
-        any may be 0.
+    w_bound, w_edge, w_ext, w_dir, w_temp, w_uni : float
+        Weights of the shape, edge-distance, motion-extent, orientation, temporal and
+        uniformity terms; any may be 0. The edge guide is the thesis's border channel
+        ``df = min(dist / border_width, 1)`` (section 3.4), floored at −1 outside the mask.
     uniformity_lambda : float
         λ: the uniformity penalty at exactly the budget (Ω = ω*) in the units of the
         colour SSD (sRGB in [0, 1]); the penalty weight is ``w_uni · λ``.
@@ -116,6 +117,7 @@ class Params:
 
     patch_size: int = 5
     w_bound: float = 4.0
+    w_edge: float = 4.0
     w_ext: float = 0.25
     w_dir: float = 0.0
     w_temp: float = 4.0
@@ -149,7 +151,7 @@ class Params:
             object.__setattr__(self, name, tuple(int(v) for v in value))
         checks = (
             ("patch_size", self.patch_size >= 3 and self.patch_size % 2 == 1, "an odd number ≥ 3"),
-            ("w_bound", self.w_bound >= 0, "≥ 0"), ("w_ext", self.w_ext >= 0, "≥ 0"),
+            ("w_bound", self.w_bound >= 0, "≥ 0"), ("w_edge", self.w_edge >= 0, "≥ 0"), ("w_ext", self.w_ext >= 0, "≥ 0"),
             ("w_dir", self.w_dir >= 0, "≥ 0"), ("w_temp", self.w_temp >= 0, "≥ 0"),
             ("w_uni", self.w_uni >= 0, "≥ 0"), ("uniformity_lambda", self.uniformity_lambda >= 0, "≥ 0"),
             ("cuboid_radius", self.cuboid_radius >= 0, "≥ 0"),
@@ -337,11 +339,13 @@ class _Sequence:
         unit = np.float32(1.0 / params.ext_unit)
         length = source.frame_count if params.source_window is None else min(params.source_window, source.frame_count)
         guide_range, colour_range = _quantization_ranges(target, source, unit, sliding=length < source.frame_count)
-        prepare = functools.partial(_prepare_exemplar, unit=unit, guide_range=guide_range, colour_range=colour_range,
+        prepare = functools.partial(_prepare_exemplar, unit=unit, border_width=target.border_width,
+                                    guide_range=guide_range, colour_range=colour_range,
                                     synthesis=synthesis)
         return cls(
             params=params, target=target, synthesis=synthesis, unit=unit,
-            guide_weights=np.array([params.w_bound, params.w_ext, params.w_ext] + [params.w_temp] * 3, np.float32),
+            guide_weights=np.array([params.w_bound, params.w_edge, params.w_ext, params.w_ext] + [params.w_temp] * 3,
+                                   np.float32),
             d=max(target.height, target.width), window=_SlidingWindow(source, length, target.frame_count, prepare),
         )
 
@@ -362,26 +366,32 @@ def _quantization_ranges(target: guides.GuideCache, source: Source | StoredSourc
     """
     ext_max = max(target.meta["ext_plus_max"], target.meta["ext_minus_max"]) * unit
     if not sliding:
-        return ([0.0] * 6, [1.0, ext_max, ext_max, 1.0, 1.0, 1.0]), None
+        return ([0.0, -1.0] + [0.0] * 5, [1.0, 1.0, ext_max, ext_max, 1.0, 1.0, 1.0]), None
     low, high = -_RANGE_MARGIN, 1.0 + _RANGE_MARGIN
     ext_max = max(ext_max, source.ext_max * float(unit)) * high
-    return ([low] * 6, [high, ext_max, ext_max, high, high, high]), ([low] * 3, [high] * 3)
+    return ([low, -high] + [low] * 5, [high, high, ext_max, ext_max, high, high, high]), ([low] * 3, [high] * 3)
 
 
-def _prepare_exemplar(frames: Source, *, unit: np.float32, guide_range, colour_range, synthesis: SynthesisParams):
+def _prepare_exemplar(frames: Source, *, unit: np.float32, border_width: float, guide_range, colour_range,
+                      synthesis: SynthesisParams):
     """The engine's prepared source (pyramid, features) of exemplar ``frames``.
 
-    Its guides pair with the target's (``_GUIDES``): shape, ext± in ``unit``, and its colour,
+    Its guides pair with the target's (``_GUIDES``): shape, edge (:func:`edge_guide`), ext± in ``unit``, and its colour,
     which the temporal guide is compared with.
     """
     return prepare_engine_source(
         frames.rgb, np.concatenate([
-            frames.shape[..., None], frames.ext_plus[..., None] * unit, frames.ext_minus[..., None] * unit,
-            frames.rgb,
+            frames.shape[..., None], edge_guide(frames.dist, border_width)[..., None],
+            frames.ext_plus[..., None] * unit, frames.ext_minus[..., None] * unit, frames.rgb,
         ], axis=3),
         guide_weight_map=_WEIGHT_MAP, opposite_guide=_OPPOSITE, source_angle=frames.angle,
         source_segment=frames.segment, guide_range=guide_range, colour_range=colour_range, params=synthesis,
     )
+
+
+def edge_guide(dist: np.ndarray, border_width: float) -> np.ndarray:
+    """The thesis's border channel ``df = min(dist / border_width, 1)`` (section 3.4), floored at −1 outside."""
+    return np.clip(np.asarray(dist, np.float32) / np.float32(border_width), -1.0, 1.0)
 
 
 def _stylize_step(sequence: _Sequence, k: int, index: int, mask, previous: _Previous | None,
@@ -457,7 +467,8 @@ def _synthesize(sequence: _Sequence, k: int, frame: guides.FrameGuides, inside: 
                 keep_margin = carried_margin(modulation[0], wanted, previous.inside, params)
     unit = sequence.unit
     target_guides = np.concatenate([
-        frame.shape[..., None], frame.ext_plus[..., None] * unit, frame.ext_minus[..., None] * unit, temp,
+        frame.shape[..., None], edge_guide(frame.dist, target.border_width)[..., None],
+        frame.ext_plus[..., None] * unit, frame.ext_minus[..., None] * unit, temp,
     ], axis=2)
     result = synthesize_prepared(
         held.prepared,
