@@ -30,6 +30,7 @@ from pathlib import Path
 from typing import Callable, NamedTuple
 
 import numpy as np
+import yaml
 from PIL import Image
 
 from fluidymation import quality
@@ -415,6 +416,14 @@ frames over paper, and the change into the middle frame where both frames are in
 """)
 
 
+def _overrides(items: list[str]) -> dict:
+    """``NAME=VALUE`` options as keyword arguments, each value read as YAML (``opt_iters=[4, 2, 2]``)."""
+    pairs = [item.split("=", 1) for item in items]
+    if any(len(pair) != 2 for pair in pairs):
+        raise SystemExit(f"expected NAME=VALUE, got {items}")
+    return {name: tuple(value) if isinstance(value := yaml.safe_load(text), list) else value for name, text in pairs}
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--scenes", nargs="+", default=[s.name for s in SCENES], choices=[s.name for s in SCENES],
@@ -424,6 +433,10 @@ def main():
     parser.add_argument("--write-docs", action="store_true", help="write docs/quality.md and docs/quality/*.png")
     parser.add_argument("--record-baseline", action="store_true",
                         help="store this run's texture fidelity as the baseline (docs/quality/baseline.json)")
+    parser.add_argument("--param", action="append", default=[], metavar="NAME=VALUE",
+                        help="a stylizer parameter instead of its default (YAML value; repeatable)")
+    parser.add_argument("--guide", action="append", default=[], metavar="NAME=VALUE",
+                        help="a guides parameter instead of its default (YAML value; repeatable)")
     args = parser.parse_args()
     scenes = [s for s in SCENES if s.name in args.scenes]
     command = "NUMBA_CACHE_DIR=.numba-cache .venv/bin/python " + shlex.join(["tests/benchmarks/bench_quality.py",
@@ -431,8 +444,8 @@ def main():
     started = datetime.datetime.now().strftime("%Y-%m-%d %H:%M")
     clock, load_start = time.perf_counter(), os.getloadavg()
     print(f"{command}\nload average {load_start[0]:.2f} {load_start[1]:.2f} {load_start[2]:.2f}", flush=True)
-    params = default_params(get_stylizer("fluidymation"))
-    guide_params = guides.Params()
+    params = dataclasses.replace(default_params(get_stylizer("fluidymation")), **_overrides(args.param))
+    guide_params = guides.Params(**_overrides(args.guide))
     baseline = json.loads(BASELINE.read_text()) if BASELINE.is_file() else {}
     results, sheet_rows = [], {s.name: [] for s in scenes}
     with tempfile.TemporaryDirectory() as workdir:
