@@ -29,6 +29,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 from stages import test_stylize as scene  # noqa: E402
 
 from fluidymation.engine.shiftnnf import shift_nnf  # noqa: E402
+from fluidymation.quality import local_contrast  # noqa: E402
 from fluidymation.stages import exemplar_store, guides, stylize  # noqa: E402
 
 
@@ -76,8 +77,8 @@ def measure_moving(source, frames, speed, workdir, params):
     inner = ndimage.binary_erosion(moving(0) > 0.5, iterations=4)
     both = inner & np.roll(inner, travel, axis=1)
     following = np.abs(np.roll(first, travel, axis=1) - last)[both].mean() / np.abs(first - last)[both].mean()
-    exemplar = np.mean([scene._local_contrast(source.rgb[i], source.segment[i] >= 0) for i in range(source.frame_count)])
-    contrast = [scene._local_contrast(r.rgba, moving(r.index) > 0.5) / exemplar for r in results]
+    exemplar = np.mean([local_contrast(source.rgb[i], source.segment[i] >= 0) for i in range(source.frame_count)])
+    contrast = [local_contrast(r.rgba, moving(r.index) > 0.5) / exemplar for r in results]
     print(f"motion-following ratio over {len(results) - 1} frames: {following:.3f} (below 1: the texture travelled)")
     print(f"contrast ratio per frame: {' '.join(f'{c:.2f}' for c in contrast)}")
 

@@ -131,12 +131,12 @@ def test_ablate_renders_each_term_switched_off_side_by_side(cli, tmp_path, monke
     folder = tmp_path / "out" / "ablate" / "blob"
     variants = sorted(p.name for p in folder.iterdir() if p.is_dir())
     # w_dir is 0 by default, so "no dir" equals "full" and gets no panel of its own
-    assert variants == ["full", "no-bound", "no-dir-bound", "no-ext", "no-temp", "no-uni"]
+    assert variants == ["full", "no-bound", "no-dir-bound", "no-edge", "no-ext", "no-temp", "no-uni"]
     assert "no dir: the weight is already 0" in out
     assert not (tmp_path / "out" / "report.json").exists()  # a film's report is not overwritten by ablate
     full, no_temp = (iio.imread(folder / name / "00001.png") for name in ("full", "no-temp"))
     assert not np.array_equal(full, no_temp)
     with av.open(str(tmp_path / "out" / "ablate" / "blob.mp4")) as container:
         stream = container.streams.video[0]
-        assert (stream.codec_context.width, stream.codec_context.height) == (6 * 40, 40 + 14)
+        assert (stream.codec_context.width, stream.codec_context.height) == (7 * 40, 40 + 14)
         assert sum(1 for _ in container.decode(stream)) == 2
