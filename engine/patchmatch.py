@@ -64,7 +64,7 @@ def _penalty_at(penalty, use_penalty, scale, frame, x, y):
 def _search(
     cost, source_segment, target_segment, source_angle, target_angle, penalty, use_penalty, penalty_scale, keep_margin,
     nnf_frame, nnf_coords, error, start_frame, start_coords,
-    rotation_mode, alpha, seed, salt, reverse, tile_rows,
+    rotation_mode, alpha, random_search, seed, salt, reverse, tile_rows,
 ):
     height, width = nnf_frame.shape
     frames, source_height, source_width = source_segment.shape
@@ -72,7 +72,7 @@ def _search(
     high_y = np.float32(source_height - 1)
     boxes = 0
     scale = 1.0
-    while scale * max(source_width, source_height) >= 1.0:
+    while random_search and scale * max(source_width, source_height) >= 1.0:
         boxes += 1
         scale *= alpha
     step = -1 if reverse else 1
@@ -239,8 +239,8 @@ def _search(
 
 
 def patchmatch_pass(cost, nnf, error, *, penalty=None, penalty_scale=None, keep_margin=None, rotation_mode=0,
-                    alpha=0.75, seed=0, salt=0, reverse=False, tile_rows=TILE_ROWS):
-    """One PatchMatch iteration (propagation, then random search), in place.
+                    alpha=0.75, random_search=True, seed=0, salt=0, reverse=False, tile_rows=TILE_ROWS):
+    """One PatchMatch iteration (propagation, then random search unless ``random_search`` is False), in place.
 
     Parameters
     ----------
@@ -261,6 +261,8 @@ def patchmatch_pass(cost, nnf, error, *, penalty=None, penalty_scale=None, keep_
         ``ROTATION_NONE`` or ``ROTATION_FLOW`` (the two flow-aligned angles).
     alpha : float
         Shrink factor of the random-search box (0 < alpha < 1).
+    random_search : bool
+        False: propagation only (a few times cheaper; it joins neighbouring matches into coherent ones).
     seed, salt : int
         Random numbers come from ``(seed, salt, y, x)``; give each pass its own salt.
     reverse : bool
@@ -282,5 +284,5 @@ def patchmatch_pass(cost, nnf, error, *, penalty=None, penalty_scale=None, keep_
         penalty, use_penalty,
         np.ascontiguousarray(penalty_scale, np.float32), np.ascontiguousarray(keep_margin, np.float32),
         nnf.frame, nnf.coords, error, nnf.frame.copy(), nnf.coords.copy(),
-        int(rotation_mode), float(alpha), int(seed), int(salt), bool(reverse), int(tile_rows),
+        int(rotation_mode), float(alpha), bool(random_search), int(seed), int(salt), bool(reverse), int(tile_rows),
     )

@@ -52,6 +52,10 @@ class SynthesisParams:
         Per level, coarsest first; the last value repeats.
     vote_only_finest : bool
         Do not optimise the finest level: only vote the upscaled NNF (when > 1 level).
+    finest_propagation_passes : int
+        With ``vote_only_finest``, PatchMatch passes of propagation only (no random search)
+        on the finest level's upscaled field before its vote: they join the 2×2 blocks that
+        each coarse match becomes into coherent matches.
     guided_initialization : bool
         After a random start, run one PatchMatch with the colour weight 0 (guides only).
     alpha : float
@@ -77,6 +81,7 @@ class SynthesisParams:
     search_vote_iters: tuple = (6,)
     patchmatch_iters: tuple = (4,)
     vote_only_finest: bool = False
+    finest_propagation_passes: int = 0
     guided_initialization: bool = False
     alpha: float = 0.75
     uniformity_weight: float = 0.0
@@ -106,6 +111,8 @@ class SynthesisParams:
             raise ValueError(f"histogram_matching must lie in [0, 1], got {self.histogram_matching}")
         if self.rotation not in _ROTATIONS:
             raise ValueError(f"rotation must be one of {sorted(_ROTATIONS)}, got {self.rotation!r}")
+        if self.finest_propagation_passes < 0:
+            raise ValueError(f"finest_propagation_passes must be ≥ 0, got {self.finest_propagation_passes}")
         if self.seed < 0 or self.tile_rows < 1:
             raise ValueError("seed must be ≥ 0 and tile_rows ≥ 1")
 
@@ -570,16 +577,17 @@ def _synthesize_level(prepared, target, params, *, rank, level, nnf, optimise, t
                             tile_rows=params.tile_rows)
         colour = revote()
 
-    if not optimise:
+    if not optimise and params.finest_propagation_passes == 0:
         return nnf, colour, cost
     scales = None
     if params.uniformity_weight > 0:
         scales = budget_scales(source_segment=cost.source_segment, target_segment=cost.target_segment,
                                patch_size=params.patch_size, frame_radius=params.uniformity_radius,
                                weight=params.uniformity_weight)
-    for em in range(_schedule(params.search_vote_iters, rank)):
+
+    def search(passes, phase, em, random_search):
         error = patch_errors(cost, nnf)
-        for iteration in range(_schedule(params.patchmatch_iters, rank)):
+        for iteration in range(passes):
             penalty = None
             if scales is not None:
                 occurrence = occurrence_map(nnf, source_shape=cost.source_segment.shape,
@@ -587,9 +595,15 @@ def _synthesize_level(prepared, target, params, *, rank, level, nnf, optimise, t
                 penalty = uniformity_penalty(occurrence, source_segment=cost.source_segment, scales=scales,
                                              patch_size=params.patch_size)
             patchmatch_pass(cost, nnf, error, penalty=penalty, penalty_scale=uniformity_scale, keep_margin=keep_margin,
-                            rotation_mode=rotation_mode, alpha=params.alpha,
-                            seed=params.seed, salt=_salt(level, 3, em, iteration), reverse=iteration % 2 == 1,
+                            rotation_mode=rotation_mode, alpha=params.alpha, random_search=random_search,
+                            seed=params.seed, salt=_salt(level, phase, em, iteration), reverse=iteration % 2 == 1,
                             tile_rows=params.tile_rows)
+
+    if not optimise:
+        search(params.finest_propagation_passes, 4, 0, random_search=False)
+        return nnf, revote(), cost
+    for em in range(_schedule(params.search_vote_iters, rank)):
+        search(_schedule(params.patchmatch_iters, rank), 3, em, random_search=True)
         colour = revote()
     return nnf, colour, cost
 

@@ -90,6 +90,9 @@ class Params:
         repeats.
     vote_only_finest : bool
         Only vote the finest level from the upscaled field.
+    finest_propagation : int
+        With ``vote_only_finest``, propagation-only PatchMatch passes on the finest level
+        before its vote (they join the upscaled field's 2×2 blocks; docs/stylize.md).
     guided_init : bool
         Refine the first frame's random field with a guides-only pass.
     pyramid_levels : int or None
@@ -134,6 +137,7 @@ class Params:
     opt_iters: tuple = (4, 2, 1)
     pm_iters: tuple = (6, 4, 4)
     vote_only_finest: bool = True
+    finest_propagation: int = 1
     guided_init: bool = True
     pyramid_levels: int | None = None
     reverse: bool = False
@@ -164,6 +168,7 @@ class Params:
             ("pm_iters", bool(self.pm_iters) and min(self.pm_iters) >= 0, "a list of counts ≥ 0"),
             ("pyramid_levels", self.pyramid_levels is None or self.pyramid_levels >= 1, "≥ 1"),
             ("settle_passes", self.settle_passes >= 0, "≥ 0"),
+            ("finest_propagation", self.finest_propagation >= 0, "≥ 0"),
             ("keep_margin", 0 <= self.keep_margin <= 1, "between 0 and 1"),
             ("still_speed", self.still_speed >= 0, "≥ 0"),
             ("source_window", self.source_window is None or (
@@ -331,6 +336,7 @@ class _Sequence:
         synthesis = SynthesisParams(
             patch_size=params.patch_size, pyramid_levels=params.pyramid_levels, search_vote_iters=params.opt_iters,
             patchmatch_iters=params.pm_iters, vote_only_finest=params.vote_only_finest,
+            finest_propagation_passes=params.finest_propagation,
             guided_initialization=params.guided_init, alpha=params.alpha,
             uniformity_weight=params.w_uni * params.uniformity_lambda, uniformity_radius=params.cuboid_radius,
             histogram_matching=params.histogram_matching, orientation_weight=params.w_dir,

@@ -94,3 +94,22 @@ def test_matches_stay_in_their_segment():
     for ty, tx in zip(*np.nonzero(active)):
         x, y, _ = field.coords[ty, tx]
         assert source_segment[field.frame[ty, tx], int(y + 0.5), int(x + 0.5)] == target_segment[ty, tx]
+
+
+def test_propagation_only_takes_shifted_neighbour_matches_and_never_gets_worse():
+    rng = np.random.default_rng(9)
+    cost, _, _, _ = make_cost(rng, frames=2, source=(6, 6), target=(4, 5))
+    field = NNF.empty(4, 5)
+    fill_random(field, target_segment=cost.target_segment, source_segment=cost.source_segment, seed=3)
+    before = NNF(field.frame.copy(), field.coords.copy())
+    error = patch_errors(cost, field)
+    start_error = error.copy()
+    patchmatch_pass(cost, field, error, random_search=False, seed=3, tile_rows=4)
+    assert np.all(error <= start_error)
+    np.testing.assert_allclose(error, patch_errors(cost, field), rtol=1e-6)
+    changed = np.argwhere((field.frame != before.frame) | np.any(field.coords != before.coords, axis=2))
+    assert len(changed) > 0
+    for ty, tx in changed:  # θ = 0 here: the left or upper neighbour's new match, one pixel on (clamped)
+        offers = [(field.frame[ny, nx], min(field.coords[ny, nx, 0] + tx - nx, 5), min(field.coords[ny, nx, 1] + ty - ny, 5))
+                  for ny, nx in ((ty, tx - 1), (ty - 1, tx)) if ny >= 0 and nx >= 0]
+        assert (field.frame[ty, tx], field.coords[ty, tx, 0], field.coords[ty, tx, 1]) in offers
