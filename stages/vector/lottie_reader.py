@@ -180,43 +180,50 @@ def _read_dotlottie(raw: bytes, path: Path, animation: str | None,
             if "manifest.json" in names else {}
         listed = [entry for entry in _list(manifest.get("animations")) if isinstance(entry, dict)
                   and isinstance(entry.get("id"), str)]
-        stored = sorted(n for n in names if n.split("/")[0] in _DOTLOTTIE_ANIMATIONS and n.endswith(".json")
-                        and n.count("/") == 1)
-        if animation is not None:
-            entry = next((entry for entry in listed if entry["id"] == animation), {"id": animation})
-            member = next((m for m in stored if m.split("/")[1] == f"{animation}.json"), None)
-            if member is None:
-                held = ", ".join(m.split("/")[1][:-5] for m in stored) or "none"
-                raise InputError(f"{source}: the scene's animation '{animation}' is not in the archive "
-                                 f"(its animations: {held})")
-        else:
-            entry = listed[0] if listed else {}
-            candidates = [f"{folder}/{entry['id']}.json" for folder in _DOTLOTTIE_ANIMATIONS] if entry else []
-            member = next((n for n in candidates + stored if n in names), None)
-            if member is None:
-                raise InputError(f"{source}: the dotLottie archive holds no animations/*.json (or a/*.json)")
-            if entry and not member.endswith(f"/{entry['id']}.json"):
-                entry = {}
+        entry, member = _pick_animation(listed, names, animation, source)
         data = _parse_json(read_zip_member(archive, member, source), f"{source}:{member}")
         _embed_archive_images(data, archive, names, source)
-        chosen = member.split("/")[1][:-5]
+        chosen = _member_id(member)
         choices = {"animation": chosen}
         skipped = []
-        if theme is None:
-            theme = entry.get("initialTheme") if isinstance(entry.get("initialTheme"), str) else None
-            where = "the manifest's initial theme"
-        else:
-            where = "the scene's theme"
+        where = "the scene's theme" if theme is not None else "the manifest's initial theme"
+        if theme is None and isinstance(entry.get("initialTheme"), str):
+            theme = entry["initialTheme"]
         if theme is not None:
             theme_member = f"t/{theme}.json"
             if theme_member not in names:
-                held = ", ".join(n[2:-5] for n in names if n.startswith("t/") and n.endswith(".json")) or "none"
+                held = ", ".join(_member_id(n) for n in names if n.startswith("t/") and n.endswith(".json")) or "none"
                 raise InputError(f"{source}: {where} '{theme}' is not in the archive ({theme_member}; "
                                  f"its themes: {held})")
             rules = _parse_json(read_zip_member(archive, theme_member, source), f"{source}:{theme_member}")
             skipped = _apply_theme(data, rules, theme, chosen)
             choices["theme"] = theme
     return data, skipped, choices
+
+
+def _pick_animation(listed: list[dict], names: list[str], animation: str | None, source: str) -> tuple[dict, str]:
+    """The manifest entry (empty when the manifest does not list it) and archive member of the animation to read:
+    ``animation`` by id, else the manifest's first, else the first stored by name."""
+    stored = sorted(n for n in names if n.split("/")[0] in _DOTLOTTIE_ANIMATIONS and n.endswith(".json")
+                    and n.count("/") == 1)
+    if animation is not None:
+        member = next((m for m in stored if _member_id(m) == animation), None)
+        if member is None:
+            held = ", ".join(_member_id(m) for m in stored) or "none"
+            raise InputError(f"{source}: the scene's animation '{animation}' is not in the archive "
+                             f"(its animations: {held})")
+        return next((entry for entry in listed if entry["id"] == animation), {}), member
+    first = listed[0] if listed else {}
+    candidates = [f"{folder}/{first['id']}.json" for folder in _DOTLOTTIE_ANIMATIONS] if first else []
+    member = next((n for n in candidates + stored if n in names), None)
+    if member is None:
+        raise InputError(f"{source}: the dotLottie archive holds no animations/*.json (or a/*.json)")
+    return (first if first and _member_id(member) == first["id"] else {}), member
+
+
+def _member_id(member: str) -> str:
+    """The id of an archive member ``folder/<id>.json``."""
+    return member.split("/", 1)[1][: -len(".json")]
 
 
 def _apply_theme(data: dict, theme: dict, name: str, animation: str) -> list[Unsupported]:
