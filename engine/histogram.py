@@ -10,7 +10,8 @@ of the vote rather than Kopf's reweighting of the contributions). The reference 
 not the whole exemplar but the frames the field draws from, each weighted by its number
 of matches, so a target painted from early (wet) frames keeps their look: per segment
 and channel, the target's values are ranked and replaced by the quantiles of that
-mixture of per-frame distributions.
+mixture of per-frame distributions. Where segments meet, the remappings are blended
+(:func:`match_histograms`' ``blend``), so no seam appears along the meeting line.
 
 Each frame's distribution is kept as :data:`QUANTILES` quantiles per segment and
 channel, computed once per source (:func:`quantile_tables`).
@@ -58,8 +59,15 @@ def join_tables(parts: list[np.ndarray]) -> np.ndarray:
 
 
 def match_histograms(colour: np.ndarray, nnf_frame: np.ndarray, target_segment: np.ndarray, tables: np.ndarray,
-                     strength: float) -> np.ndarray:
+                     strength: float, blend: np.ndarray | None = None) -> np.ndarray:
     """Move a voted image's values towards the distribution of the exemplar frames its matches use.
+
+    Each segment gets its own remapping, a monotone function of the value: its pixels'
+    ranks onto the quantiles of its source frames (weighted by their matches). Applied
+    each to its own segment only, two remappings differ at the segments' meeting line and
+    draw a seam there; ``blend`` instead mixes them per pixel with smooth weights, the way
+    contrast-limited adaptive equalization interpolates between the mappings of
+    neighbouring tiles.
 
     Parameters
     ----------
@@ -72,7 +80,10 @@ def match_histograms(colour: np.ndarray, nnf_frame: np.ndarray, target_segment: 
     tables : ndarray
         From :func:`quantile_tables` for the same source.
     strength : float
-        0 keeps the vote, 1 replaces each value by its matched quantile.
+        0 keeps the vote, 1 replaces each value by its remapped one.
+    blend : ndarray, shape (labels, H, W), float, optional
+        How much of each segment's remapping a pixel takes (normalized over the segments
+        that have one). Default: all of its own segment's.
 
     Returns
     -------
@@ -82,27 +93,48 @@ def match_histograms(colour: np.ndarray, nnf_frame: np.ndarray, target_segment: 
     out = colour.copy()
     frames, labels, channels, quantiles = tables.shape
     matched = (nnf_frame >= 0) & (target_segment >= 0) & (target_segment < labels)
+    values = out[matched]
+    own = target_segment[matched]
+    mixed = np.zeros(values.shape, np.float64)
+    total = np.zeros(len(values), np.float64)
     for label in range(labels):
-        pixels = matched & (target_segment == label)
-        count = int(pixels.sum())
-        if count == 0:
+        members = own == label
+        remapping = _segment_remapping(values[members], nnf_frame[matched][members], tables[:, label])
+        if remapping is None:
             continue
-        uses = np.bincount(nnf_frame[pixels], minlength=frames)[:frames].astype(np.float64)
-        uses[np.isnan(tables[:, label, 0, 0])] = 0.0
-        used = np.flatnonzero(uses)
-        if used.size == 0:
-            continue
-        weights = np.repeat(uses[used] / (uses[used].sum() * quantiles), quantiles)
-        ranks = (np.arange(count) + 0.5) / count  # the quantile each value moves to, by its rank
-        values = out[pixels]
-        for channel in range(channels):
-            pool = tables[used, label, channel].ravel()
-            order = np.argsort(pool, kind="stable")
-            cumulative = np.cumsum(weights[order]) - 0.5 * weights[order]
-            wanted = np.interp(ranks, cumulative, pool[order]).astype(np.float32)
-            ranked = np.argsort(values[:, channel], kind="stable")
-            target = np.empty(count, np.float32)
-            target[ranked] = wanted
-            values[:, channel] += np.float32(strength) * (target - values[:, channel])
-        out[pixels] = values
+        weight = (members if blend is None else blend[label][matched]).astype(np.float64)
+        for channel, (order, wanted) in enumerate(remapping):
+            moved = np.interp(values[:, channel], values[members, channel][order], wanted)
+            moved[np.flatnonzero(members)[order]] = wanted  # ties within the segment keep their own ranks
+            mixed[:, channel] += weight * moved
+        total += weight
+    remapped = total > 0
+    target = mixed[remapped] / total[remapped, None]
+    values[remapped] += np.float32(strength) * (target.astype(np.float32) - values[remapped])
+    out[matched] = values
     return out
+
+
+def _segment_remapping(values: np.ndarray, frames_used: np.ndarray, table: np.ndarray):
+    """Per channel, (the order that sorts the segment's votes, the values they move to in that order), or
+    None without a reference.
+
+    ``table`` is one label's :func:`quantile_tables` part, (T, C, QUANTILES); the reference
+    is the mixture of the frames ``frames_used`` names, each weighted by its count."""
+    if len(values) == 0:
+        return None
+    frames, channels, quantiles = table.shape
+    uses = np.bincount(frames_used, minlength=frames)[:frames].astype(np.float64)
+    uses[np.isnan(table[:, 0, 0])] = 0.0
+    used = np.flatnonzero(uses)
+    if used.size == 0:
+        return None
+    weights = np.repeat(uses[used] / (uses[used].sum() * quantiles), quantiles)
+    ranks = (np.arange(len(values)) + 0.5) / len(values)  # the quantile each value moves to, by its rank
+    remapping = []
+    for channel in range(channels):
+        pool = table[used, channel].ravel()
+        order = np.argsort(pool, kind="stable")
+        cumulative = np.cumsum(weights[order]) - 0.5 * weights[order]
+        remapping.append((np.argsort(values[:, channel], kind="stable"), np.interp(ranks, cumulative, pool[order])))
+    return remapping

@@ -189,7 +189,9 @@ class TargetInputs:
     that describe the target; ``target_guides`` in the prepared source's guide order),
     ``uniformity_scale`` (H, W): a per-pixel factor of the uniformity penalty (default 1), and
     ``keep_margin`` (H, W): the relative improvement in patch cost a match needs to replace the
-    one held, including ``initial_nnf``'s in the per-level merge (default 0)."""
+    one held, including ``initial_nnf``'s in the per-level merge (default 0), and
+    ``histogram_blend`` (K, H, W): how much of each segment's histogram remapping a pixel takes
+    (:func:`~fluidymation.engine.histogram.match_histograms`; default: its own segment's)."""
 
     target_guides: np.ndarray
     colour_weights: np.ndarray
@@ -200,6 +202,7 @@ class TargetInputs:
     initial_nnf: NNF | None = None
     uniformity_scale: np.ndarray | None = None
     keep_margin: np.ndarray | None = None
+    histogram_blend: np.ndarray | None = None
 
 
 @dataclass(frozen=True)
@@ -321,7 +324,8 @@ def _check_target(target, colours, guides):
     if np.shape(target.colour_weights) != (colours,) or np.shape(target.guide_weights) != (guides,):
         raise ValueError("colour_weights and guide_weights need one weight per channel")
     shapes = {"weight_maps": (None, height, width), "target_angle": (height, width), "target_segment": (height, width),
-              "uniformity_scale": (height, width), "keep_margin": (height, width)}
+              "uniformity_scale": (height, width), "keep_margin": (height, width),
+              "histogram_blend": (None, height, width)}
     for name, shape in shapes.items():
         value = getattr(target, name)
         if value is not None and (value.ndim != len(shape)
@@ -498,6 +502,7 @@ def _synthesize(source, target, params, target_guides):
     weight_maps = _pyramid_or_none(target.weight_maps, levels, _downsample_maps)
     uniformity_scales = _pyramid_or_none(target.uniformity_scale, levels, _downsample_map)
     keep_margins = _pyramid_or_none(target.keep_margin, levels, _downsample_map)
+    histogram_blends = _pyramid_or_none(target.histogram_blend, levels, _downsample_maps)
     target_angle = _pyramid_or_none(target.target_angle, levels, downsample_angles)
     target_segments = _pyramid_or_none(np.asarray(target_segment, np.int32), levels, downsample_labels)
     nnf = None
@@ -509,6 +514,7 @@ def _synthesize(source, target, params, target_guides):
                 optimise=not (level == 0 and levels > 1 and params.vote_only_finest), target_guides=target_guides[level],
                 weight_maps=weight_maps[level], target_angle=target_angle[level], target_segment=target_segments[level],
                 uniformity_scale=uniformity_scales[level], keep_margin=keep_margins[level],
+                histogram_blend=histogram_blends[level],
             )
     with threads_for(height * width):
         error = patch_errors(cost, nnf)
@@ -516,7 +522,7 @@ def _synthesize(source, target, params, target_guides):
 
 
 def _synthesize_level(prepared, target, params, *, rank, level, nnf, optimise, target_guides, weight_maps, target_angle,
-                      target_segment, uniformity_scale, keep_margin):
+                      target_segment, uniformity_scale, keep_margin, histogram_blend):
     """One pyramid level: start from ``nnf`` (the coarser level's, or None), return (nnf, colour, cost)."""
     rotation_mode = _ROTATIONS[params.rotation]
     level_height, level_width = target_guides.shape[:2]
@@ -542,7 +548,7 @@ def _synthesize_level(prepared, target, params, *, rank, level, nnf, optimise, t
             if prepared.quantiles is None:
                 raise ValueError("histogram_matching needs a source prepared with it")
             colour = match_histograms(colour, nnf.frame, cost.target_segment, prepared.quantiles,
-                                      params.histogram_matching)
+                                      params.histogram_matching, blend=histogram_blend)
         cost.set_target_colour(colour)
         return colour
 

@@ -44,7 +44,7 @@ from fluidymation.stages import guides
 from fluidymation.stages.exemplar_store import Source, StoredSource, border_clamped, concatenate
 
 NAME = "stylize"
-VERSION = 3
+VERSION = 4
 
 #: Target guide channels, in order; the source compares shape, ext+, ext− and its colour (as S_temp).
 _GUIDES = ("shape", "edge", "ext_plus", "ext_minus", "temp_r", "temp_g", "temp_b")
@@ -395,6 +395,18 @@ def _prepare_exemplar(frames: Source, *, unit: np.float32, border_width: float, 
     )
 
 
+def segment_blend(dist: np.ndarray, border_width: float) -> np.ndarray:
+    """How much of the border's (0) and the interior's (1) histogram remapping each pixel takes, (2, H, W).
+
+    Each segment's remapping holds alone from its middle on: the border's up to half a border
+    width from the edge, the interior's from one and a half; in between they blend linearly
+    with the distance, as adaptive equalization blends between tile centres. Applied each to
+    its own segment, they would draw a seam ring along the split (docs/stylize.md).
+    """
+    interior = np.clip(np.asarray(dist, np.float32) / np.float32(border_width) - 0.5, 0.0, 1.0)
+    return np.stack([1.0 - interior, interior])
+
+
 def edge_guide(dist: np.ndarray, border_width: float) -> np.ndarray:
     """The thesis's border channel ``df = min(dist / border_width, 1)`` (section 3.4), floored at −1 outside."""
     return np.clip(np.asarray(dist, np.float32) / np.float32(border_width), -1.0, 1.0)
@@ -482,7 +494,7 @@ def _synthesize(sequence: _Sequence, k: int, frame: guides.FrameGuides, inside: 
             target_guides=target_guides, colour_weights=np.ones(3, np.float32), guide_weights=sequence.guide_weights,
             weight_maps=modulation, target_angle=frame.direction, target_segment=segment, initial_nnf=initial,
             uniformity_scale=1.0 - (1.0 - np.float32(params.uni_carried)) * modulation[0],
-            keep_margin=keep_margin,
+            keep_margin=keep_margin, histogram_blend=segment_blend(frame.dist, target.border_width),
         ),
         dataclasses.replace(sequence.synthesis,
                             seed=int(counter_hash(params.seed, k, settle_pass) % np.uint64(2**31))),

@@ -59,10 +59,29 @@ def test_each_segment_matched_on_its_own():
     colour, segment = _source()
     colour[:, :, 4:] += 10  # label 1 lives around 10..13
     tables = quantile_tables(colour, segment, labels=2)
-    vote = np.full((2, 2, 1), 5.0, np.float32)
+    vote = np.array([[0, 1], [0, 1]], np.float32)[..., None]
     target_segment = np.array([[0, 0], [1, 1]], np.int32)
     out = match_histograms(vote, np.zeros((2, 2), np.int32), target_segment, tables, strength=1.0)
     assert np.all(out[0] < 1.0) and np.all((out[1] >= 10.0) & (out[1] < 11.0))
+
+
+def test_blended_segments_take_the_weighted_mean_of_both_remappings():
+    colour, segment = _source()
+    colour[:, :, 4:] += 10
+    tables = quantile_tables(colour, segment, labels=2)
+    vote = np.array([[0, 1, 2, 3, 0, 1, 2, 3]], np.float32)[..., None]  # the same votes in both segments
+    target_segment = np.array([[0, 0, 0, 0, 1, 1, 1, 1]], np.int32)
+    frames = np.zeros((1, 8), np.int32)
+    own = match_histograms(vote, frames, target_segment, tables, strength=1.0)
+    one_hot = np.stack([target_segment == 0, target_segment == 1]).astype(np.float32)
+    np.testing.assert_array_equal(match_histograms(vote, frames, target_segment, tables, 1.0, blend=one_hot), own)
+    interior_weight = np.array([[0.0, 0.25, 0.5, 1.0, 0.0, 0.25, 0.5, 1.0]], np.float32)
+    blended = match_histograms(vote, frames, target_segment, tables, 1.0,
+                               blend=np.stack([1 - interior_weight, interior_weight]))
+    # a vote v remaps to R0(v) in segment 0 and R1(v) in segment 1 (both read off ``own``)
+    expected = (1 - interior_weight) * own[0, :4, 0][[0, 1, 2, 3, 0, 1, 2, 3]] \
+        + interior_weight * own[0, 4:, 0][[0, 1, 2, 3, 0, 1, 2, 3]]
+    np.testing.assert_allclose(blended[..., 0], expected, rtol=1e-6)
 
 
 def test_tables_of_frame_ranges_join_into_the_whole():
