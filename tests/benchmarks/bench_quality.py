@@ -1,18 +1,20 @@
 """Quality benchmark (issue 15): scenes with known motion, stylized with every built-in medium.
 
 Run: ``NUMBA_CACHE_DIR=.numba-cache .venv/bin/python tests/benchmarks/bench_quality.py
-[--scenes translation still ...] [--media watercolor-bloom ...] [--write-docs] [--record-baseline]``.
+[--scenes translation still ...] [--media watercolor-bloom ...] [--scale K] [--exemplar-size N]
+[--write-docs] [--record-baseline]``.
 
-Each scene is a 128×128 layer of 12 frames drawn analytically here (soft 1-px edges),
-stylized with the stylizer's defaults (configs/fluidymation.yaml, the guides' defaults)
-from a 96×96×12 built-in exemplar (generated once into the user cache); scenes with a
-still region are rendered a second time with ``w_temp: 0``. The metrics
-(:mod:`fluidymation.quality`) are computed on the output and, where they have one, on
-the exemplar's own frames and masks; each cell is checked against issue 15's threshold
-(P/F). ``--write-docs`` writes the table, the command, the date and the load average to
-docs/quality.md and one contact sheet per scene to docs/quality/. ``--record-baseline``
-stores this run's texture fidelity in docs/quality/baseline.json: the "no worse than
-today" reference later runs are checked against.
+Each scene is a layer of 12 frames drawn analytically here (soft 1-px edges) on a 128-px
+canvas, or K times larger with ``--scale``, stylized with the stylizer's defaults
+(configs/fluidymation.yaml, the guides' defaults) from an N×N×12 built-in exemplar
+(default 96; generated once into the user cache); scenes with a still region are rendered
+a second time with ``w_temp: 0``. The metrics (:mod:`fluidymation.quality`) are computed on
+the output and, where they have one, on the exemplar's own frames and masks; each cell is
+checked against issue 15's threshold (P/F). ``--write-docs`` writes the table, the
+command, the date and the load average to docs/quality.md and one contact sheet per scene
+to docs/quality/ (other sizes: docs/quality-<size>-<exemplar size>.md and its folder).
+``--record-baseline`` stores this run's texture fidelity in docs/quality/baseline.json under
+its sizes: the "no worse than today" reference later runs of those sizes are checked against.
 """
 
 from __future__ import annotations
@@ -41,11 +43,11 @@ from fluidymation.pipeline.stylizers import get_stylizer
 from fluidymation.stages import exemplar_builtin, exemplar_store, guides, stylize
 
 ROOT = Path(__file__).resolve().parents[2]
-DOCS = ROOT / "docs" / "quality.md"
-SHEETS = ROOT / "docs" / "quality"
-BASELINE = SHEETS / "baseline.json"
-SIZE = 128
+BASELINE = ROOT / "docs" / "quality" / "baseline.json"
+#: side of the canvas the scenes are described on, px (drawn --scale times larger)
+DESIGN_SIZE = 128
 FRAMES = 12
+#: side of the built-in exemplars, px (default of --exemplar-size)
 EXEMPLAR_SIZE = 96
 MEDIA = ("watercolor-bloom", "watercolor-dry", "watercolor-backrun", "crumble")
 #: fewest pixels (over all frame pairs) a still region or moving band needs to be measured
@@ -53,39 +55,9 @@ MIN_REGION = 200
 FIDELITY_TOLERANCE = 1.05
 #: bands of the edge-gradient profiles listed in docs/quality.md
 CURVE_BANDS = 20
+#: JPEG quality of the contact sheets
+SHEET_QUALITY = 90
 PAPER = np.array(exemplar_builtin.PAPER_COLOUR, np.float32)
-
-_YY, _XX = np.mgrid[:SIZE, :SIZE].astype(np.float64) + 0.5
-
-
-def _soft(distance: np.ndarray) -> np.ndarray:
-    """Coverage of a shape from its signed distance (px, positive inside): a 1-px linear edge."""
-    return np.clip(distance + 0.5, 0.0, 1.0).astype(np.float32)
-
-
-def _ellipse(cx, cy, a, b, angle=0.0) -> np.ndarray:
-    """Soft ellipse with semi-axes a (along ``angle``, radians) and b; first-order distance to its edge."""
-    u = (_XX - cx) * np.cos(angle) + (_YY - cy) * np.sin(angle)
-    v = -(_XX - cx) * np.sin(angle) + (_YY - cy) * np.cos(angle)
-    g = np.maximum(np.hypot(u / a, v / b), 1e-6)
-    return _soft((1.0 - g) * g / np.maximum(np.hypot(u / a**2, v / b**2), 1e-9))
-
-
-def _capsule(x0, x1, y, radius) -> np.ndarray:
-    """Soft horizontal capsule: the points within ``radius`` of the segment (x0, y)–(x1, y)."""
-    return _soft(radius - np.hypot(_XX - np.clip(_XX, x0, x1), _YY - y))
-
-
-def _rotation(cx, cy, angle) -> np.ndarray:
-    """Displacement (H, W, 2) of a rotation by ``angle`` about (cx, cy)."""
-    x, y = _XX - cx, _YY - cy
-    return np.stack([x * np.cos(angle) - y * np.sin(angle) - x, x * np.sin(angle) + y * np.cos(angle) - y], axis=-1)
-
-
-def _scaling(cx, cy, factor) -> np.ndarray:
-    """Displacement (H, W, 2) of a scaling by ``factor`` about (cx, cy)."""
-    return np.stack([(_XX - cx) * (factor - 1.0), (_YY - cy) * (factor - 1.0)], axis=-1)
-
 
 def ratio(numerator: float, denominator: float) -> float:
     """numerator / denominator as numpy divides (inf over 0, nan for 0 / 0 or with a nan)."""
@@ -93,8 +65,54 @@ def ratio(numerator: float, denominator: float) -> float:
         return float(np.float64(numerator) / denominator)
 
 
-def _uniform(dx, dy) -> np.ndarray:
-    return np.broadcast_to(np.array([dx, dy], np.float64), (SIZE, SIZE, 2))
+class Canvas:
+    """The square the scenes are drawn on: described on a 128-px canvas, drawn ``scale`` times larger.
+
+    Shapes take centres and lengths in canvas units; the coverage they return and the
+    displacements are in output pixels."""
+
+    def __init__(self, scale: float = 1.0):
+        self.scale = float(scale)
+        self.size = int(round(DESIGN_SIZE * self.scale))
+        self.yy, self.xx = (np.mgrid[:self.size, :self.size].astype(np.float64) + 0.5) / self.scale
+
+    def soft(self, distance: np.ndarray) -> np.ndarray:
+        """Coverage from a signed distance in canvas units (positive inside): a 1-px linear edge."""
+        return np.clip(distance * self.scale + 0.5, 0.0, 1.0).astype(np.float32)
+
+    def ellipse(self, cx, cy, a, b, angle=0.0) -> np.ndarray:
+        """Soft ellipse with semi-axes a (along ``angle``, radians) and b; first-order distance to its edge."""
+        u = (self.xx - cx) * np.cos(angle) + (self.yy - cy) * np.sin(angle)
+        v = -(self.xx - cx) * np.sin(angle) + (self.yy - cy) * np.cos(angle)
+        g = np.maximum(np.hypot(u / a, v / b), 1e-6)
+        return self.soft((1.0 - g) * g / np.maximum(np.hypot(u / a**2, v / b**2), 1e-9))
+
+    def capsule(self, x0, x1, y, radius) -> np.ndarray:
+        """Soft horizontal capsule: the points within ``radius`` of the segment (x0, y)–(x1, y)."""
+        return self.soft(radius - np.hypot(self.xx - np.clip(self.xx, x0, x1), self.yy - y))
+
+    def rotation(self, cx, cy, angle) -> np.ndarray:
+        """Displacement (H, W, 2) of a rotation by ``angle`` about (cx, cy)."""
+        x, y = self.xx - cx, self.yy - cy
+        return self.scale * np.stack([x * np.cos(angle) - y * np.sin(angle) - x,
+                                      x * np.sin(angle) + y * np.cos(angle) - y], axis=-1)
+
+    def scaling(self, cx, cy, factor) -> np.ndarray:
+        """Displacement (H, W, 2) of a scaling by ``factor`` about (cx, cy)."""
+        return self.scale * np.stack([(self.xx - cx) * (factor - 1.0), (self.yy - cy) * (factor - 1.0)], axis=-1)
+
+    def uniform(self, dx, dy) -> np.ndarray:
+        """Displacement (H, W, 2) of a translation by (dx, dy) canvas units."""
+        return np.broadcast_to(self.scale * np.array([dx, dy], np.float64), (self.size, self.size, 2))
+
+    def where_left_of(self, x, left, right) -> np.ndarray:
+        """``left`` where the canvas x is below ``x``, else ``right`` (displacements)."""
+        return np.where((self.xx < x)[..., None], left, right)
+
+    def stretch_right_of(self, x, factor) -> np.ndarray:
+        """Displacement of a horizontal stretch by ``factor`` away from the line at canvas x (left of it: none)."""
+        dx = np.where(self.xx > x, (self.xx - x) * (factor - 1.0), 0.0)
+        return self.scale * np.stack([dx, np.zeros_like(dx)], axis=-1)
 
 
 class Scene(NamedTuple):
@@ -111,31 +129,34 @@ def _grow_end(t):
     return 36.0 + 5.0 * t
 
 
-def _grown_stretch(t):
-    """Anchored growth: the capsule's straight part and right cap stretch away from the fixed left cap."""
-    factor = (_grow_end(t) - 32.0) / (_grow_end(t - 1) - 32.0)
-    return np.stack([np.where(_XX > 32.0, (_XX - 32.0) * (factor - 1.0), 0.0), np.zeros_like(_YY)], axis=-1)
+def make_scenes(c: Canvas) -> tuple[Scene, ...]:
+    """The benchmark's scenes on canvas ``c`` (descriptions in canvas units, the 128-px canvas)."""
+    def grown_stretch(t):
+        """Anchored growth: the capsule's straight part and right cap stretch away from the fixed left cap."""
+        return c.stretch_right_of(32.0, (_grow_end(t) - 32.0) / (_grow_end(t - 1) - 32.0))
+
+    return (
+        Scene("translation", "ellipse 60×44 px tilted 20°, moving (2.5, 1) px/frame",
+              lambda t: c.ellipse(50 + 2.5 * t, 58 + 1.0 * t, 30, 22, np.radians(20)), lambda t: c.uniform(2.5, 1.0)),
+        Scene("rotation", "ellipse 88×48 px turning 4°/frame about its centre",
+              lambda t: c.ellipse(64, 64, 44, 24, np.radians(4 * t)), lambda t: c.rotation(64, 64, np.radians(4))),
+        Scene("scale", "ellipse 56×40 px growing uniformly to 1.6× about its centre",
+              lambda t: c.ellipse(64, 64, 28 * 1.6 ** (t / 11), 20 * 1.6 ** (t / 11)),
+              lambda t: c.scaling(64, 64, 1.6 ** (1 / 11))),
+        Scene("growth", "capsule 48 px tall, left end fixed, right end moving 5 px/frame (52→107 px wide)",
+              lambda t: c.capsule(32, _grow_end(t), 64, 24), grown_stretch),
+        Scene("shrink", "ellipse 88×64 px shrinking uniformly to 0.6× about its centre",
+              lambda t: c.ellipse(64, 64, 44 * 0.6 ** (t / 11), 32 * 0.6 ** (t / 11)),
+              lambda t: c.scaling(64, 64, 0.6 ** (1 / 11))),
+        Scene("still", "ellipse 80×56 px tilted 15°, not moving",
+              lambda t: c.ellipse(64, 64, 40, 28, np.radians(15)), lambda t: c.uniform(0.0, 0.0)),
+        Scene("two shapes", "one layer: a still disk (r 20 px) and an ellipse 32×44 px moving (2, 0.5) px/frame",
+              lambda t: np.maximum(c.ellipse(30, 64, 20, 20), c.ellipse(78 + 2.0 * t, 60 + 0.5 * t, 16, 22)),
+              lambda t: c.where_left_of(54, 0.0, c.uniform(2.0, 0.5))),
+    )
 
 
-SCENES = (
-    Scene("translation", "ellipse 60×44 px tilted 20°, moving (2.5, 1) px/frame",
-          lambda t: _ellipse(50 + 2.5 * t, 58 + 1.0 * t, 30, 22, np.radians(20)), lambda t: _uniform(2.5, 1.0)),
-    Scene("rotation", "ellipse 88×48 px turning 4°/frame about its centre",
-          lambda t: _ellipse(64, 64, 44, 24, np.radians(4 * t)), lambda t: _rotation(64, 64, np.radians(4))),
-    Scene("scale", "ellipse 56×40 px growing uniformly to 1.6× about its centre",
-          lambda t: _ellipse(64, 64, 28 * 1.6 ** (t / 11), 20 * 1.6 ** (t / 11)),
-          lambda t: _scaling(64, 64, 1.6 ** (1 / 11))),
-    Scene("growth", "capsule 48 px tall, left end fixed, right end moving 5 px/frame (52→107 px wide)",
-          lambda t: _capsule(32, _grow_end(t), 64, 24), _grown_stretch),
-    Scene("shrink", "ellipse 88×64 px shrinking uniformly to 0.6× about its centre",
-          lambda t: _ellipse(64, 64, 44 * 0.6 ** (t / 11), 32 * 0.6 ** (t / 11)),
-          lambda t: _scaling(64, 64, 0.6 ** (1 / 11))),
-    Scene("still", "ellipse 80×56 px tilted 15°, not moving",
-          lambda t: _ellipse(64, 64, 40, 28, np.radians(15)), lambda t: _uniform(0.0, 0.0)),
-    Scene("two shapes", "one layer: a still disk (r 20 px) and an ellipse 32×44 px moving (2, 0.5) px/frame",
-          lambda t: np.maximum(_ellipse(30, 64, 20, 20), _ellipse(78 + 2.0 * t, 60 + 0.5 * t, 16, 22)),
-          lambda t: np.where((_XX < 54)[..., None], 0.0, _uniform(2.0, 0.5))),
-)
+SCENE_NAMES = tuple(scene.name for scene in make_scenes(Canvas()))
 
 #: the issue's thresholds, as printed under the table
 THRESHOLDS = (
@@ -181,9 +202,9 @@ def exemplar_figures(rgb, mask, flow) -> dict:
             "still": still, "band_still": ratio(quality.pooled_mean(changes, bands, min_pixels=MIN_REGION), still)}
 
 
-def load_exemplar(medium: str, workdir: Path, guide_params: guides.Params) -> Exemplar:
-    """The medium at the benchmark's size (from the user cache) with its guides, as the pipeline makes them."""
-    params = resolve_params(medium, size=(EXEMPLAR_SIZE, EXEMPLAR_SIZE), frames=FRAMES)
+def load_exemplar(medium: str, size: int, workdir: Path, guide_params: guides.Params) -> Exemplar:
+    """The medium at ``size``² (from the user cache) with its guides, as the pipeline makes them."""
+    params = resolve_params(medium, size=(size, size), frames=FRAMES)
     made = exemplar_builtin.make_builtin_exemplar(params, cache_dir=paths.exemplar_cache_dir())
     cache = guides.compute_guides(lambda j: made.mask[j], FRAMES, params=guide_params,
                                   cache_dir=workdir / f"{medium}-source", given_flow=lambda j: made.flow[j])
@@ -298,10 +319,12 @@ def _over_paper(rgba: np.ndarray) -> np.ndarray:
     return rgba[..., :3] * alpha + PAPER * (1 - alpha)
 
 
-def _tile(image: np.ndarray) -> np.ndarray:
-    """An RGB image in [0, 1] centred on a SIZE×SIZE paper tile."""
-    tile = np.broadcast_to(PAPER, (SIZE, SIZE, 3)).copy()
-    top, left = (SIZE - image.shape[0]) // 2, (SIZE - image.shape[1]) // 2
+def _tile(image: np.ndarray, size: int) -> np.ndarray:
+    """An RGB image in [0, 1] centred on a size×size paper tile (cropped if larger)."""
+    tile = np.broadcast_to(PAPER, (size, size, 3)).copy()
+    top, left = max(size - image.shape[0], 0) // 2, max(size - image.shape[1], 0) // 2
+    top_in, left_in = max(image.shape[0] - size, 0) // 2, max(image.shape[1] - size, 0) // 2
+    image = image[top_in:top_in + size, left_in:left_in + size]
     tile[top:top + image.shape[0], left:left + image.shape[1]] = image
     return tile
 
@@ -315,14 +338,14 @@ def contact_sheet(scene: Scene, rows: list[tuple[np.ndarray, np.ndarray]], path:
     for exemplar_rgb, output in rows:
         difference = 1.0 - np.clip(5.0 * quality.change(output[middle - 1], output[middle]), 0, 1)
         difference = np.where(both[..., None], difference[..., None], PAPER)
-        lines.append(np.concatenate([_tile(exemplar_rgb[middle]), _over_paper(output[0]), _over_paper(output[middle]),
+        lines.append(np.concatenate([_tile(exemplar_rgb[middle], output.shape[1]), _over_paper(output[0]), _over_paper(output[middle]),
                                      _over_paper(output[-1]), difference], axis=1))
     sheet = (np.clip(np.concatenate(lines, axis=0), 0, 1) * 255 + 0.5).astype(np.uint8)
-    Image.fromarray(sheet).save(path, optimize=True)
+    Image.fromarray(sheet).save(path, quality=SHEET_QUALITY)
 
 
 def sheet_name(scene: Scene) -> str:
-    return scene.name.replace(" ", "-") + ".png"
+    return scene.name.replace(" ", "-") + ".jpg"
 
 
 def curves_table(results) -> str:
@@ -335,20 +358,47 @@ def curves_table(results) -> str:
     return "\n".join(lines)
 
 
-def write_docs(command: str, loads: tuple, started: str, seconds: float, rows: list[list[str]], results,
-               scenes, media) -> None:
-    sheets = "\n".join(f"- {scene.name} ({scene.description}): ![{scene.name}](quality/{sheet_name(scene)})"
+class Setup(NamedTuple):
+    """Where the scenes are drawn and how large the exemplars are; ``key`` names it in the baseline."""
+
+    canvas: Canvas
+    exemplar_size: int
+
+    @property
+    def key(self) -> str:
+        return f"{self.canvas.size}/{self.exemplar_size}"
+
+    @property
+    def is_default(self) -> bool:
+        return self.canvas.size == DESIGN_SIZE and self.exemplar_size == EXEMPLAR_SIZE
+
+    @property
+    def docs(self) -> Path:
+        """docs/quality.md for the default setup, else docs/quality-<size>-<exemplar size>.md."""
+        name = "quality" if self.is_default else f"quality-{self.canvas.size}-{self.exemplar_size}"
+        return ROOT / "docs" / f"{name}.md"
+
+    @property
+    def sheets(self) -> Path:
+        return self.docs.with_suffix("")
+
+
+def write_docs(setup: Setup, command: str, loads: tuple, started: str, seconds: float, rows: list[list[str]],
+               results, scenes, media) -> None:
+    size, exemplar_size = setup.canvas.size, setup.exemplar_size
+    sheets = "\n".join(f"- {scene.name} ({scene.description}): ![{scene.name}]({setup.sheets.name}/{sheet_name(scene)})"
                        for scene in scenes)
-    DOCS.write_text(f"""## Quality benchmark (issue 15)
+    setup.docs.write_text(f"""## Quality benchmark (issue 15)
 
 Written by `tests/benchmarks/bench_quality.py --write-docs`; do not edit by hand.
 
 Command: `{command}`. Run {started} in {seconds:.0f} s; load average
 {loads[0]:.2f} at the start, {loads[1]:.2f} at the end (2 cores).
 
-Each scene is a {SIZE}×{SIZE} layer of {FRAMES} frames with soft 1-px edges, drawn analytically by the
-benchmark, stylized with the defaults of configs/fluidymation.yaml and the guides' defaults from a
-{EXEMPLAR_SIZE}×{EXEMPLAR_SIZE}×{FRAMES} built-in exemplar of each medium (seed and colour of
+Each scene is a {size}×{size} layer of {FRAMES} frames with soft 1-px edges, drawn analytically by the
+benchmark ({setup.canvas.scale:g} × the 128-px canvas its descriptions use), stylized with the defaults of
+configs/fluidymation.yaml and the guides' defaults from a
+{exemplar_size}×{exemplar_size}×{FRAMES} built-in exemplar of each medium (seed and colour of
 configs/exemplars.yaml). Media: {', '.join(media)}.
 
 {markdown_table(rows)}
@@ -426,19 +476,25 @@ def _overrides(items: list[str]) -> dict:
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--scenes", nargs="+", default=[s.name for s in SCENES], choices=[s.name for s in SCENES],
-                        metavar="SCENE", help=f"scenes to run (default all: {', '.join(s.name for s in SCENES)})")
+    parser.add_argument("--scenes", nargs="+", default=list(SCENE_NAMES), choices=SCENE_NAMES,
+                        metavar="SCENE", help=f"scenes to run (default all: {', '.join(SCENE_NAMES)})")
     parser.add_argument("--media", nargs="+", default=list(MEDIA), choices=MEDIA, metavar="MEDIUM",
                         help=f"built-in exemplars (default all: {', '.join(MEDIA)})")
-    parser.add_argument("--write-docs", action="store_true", help="write docs/quality.md and docs/quality/*.png")
+    parser.add_argument("--scale", type=float, default=1.0,
+                        help="draw the scenes this many times larger than their 128-px canvas (default 1)")
+    parser.add_argument("--exemplar-size", type=int, default=EXEMPLAR_SIZE,
+                        help=f"side of the built-in exemplars, px (default {EXEMPLAR_SIZE}; their own default: 256)")
+    parser.add_argument("--write-docs", action="store_true",
+                        help="write docs/quality.md and docs/quality/*.png (other sizes: docs/quality-<size>-<exemplar>*)")
     parser.add_argument("--record-baseline", action="store_true",
-                        help="store this run's texture fidelity as the baseline (docs/quality/baseline.json)")
+                        help="store this run's texture fidelity as the baseline of its sizes (docs/quality/baseline.json)")
     parser.add_argument("--param", action="append", default=[], metavar="NAME=VALUE",
                         help="a stylizer parameter instead of its default (YAML value; repeatable)")
     parser.add_argument("--guide", action="append", default=[], metavar="NAME=VALUE",
                         help="a guides parameter instead of its default (YAML value; repeatable)")
     args = parser.parse_args()
-    scenes = [s for s in SCENES if s.name in args.scenes]
+    setup = Setup(Canvas(args.scale), args.exemplar_size)
+    scenes = [s for s in make_scenes(setup.canvas) if s.name in args.scenes]
     command = "NUMBA_CACHE_DIR=.numba-cache .venv/bin/python " + shlex.join(["tests/benchmarks/bench_quality.py",
                                                                              *sys.argv[1:]])
     started = datetime.datetime.now().strftime("%Y-%m-%d %H:%M")
@@ -446,12 +502,13 @@ def main():
     print(f"{command}\nload average {load_start[0]:.2f} {load_start[1]:.2f} {load_start[2]:.2f}", flush=True)
     params = dataclasses.replace(default_params(get_stylizer("fluidymation")), **_overrides(args.param))
     guide_params = guides.Params(**_overrides(args.guide))
-    baseline = json.loads(BASELINE.read_text()) if BASELINE.is_file() else {}
+    baselines = json.loads(BASELINE.read_text()) if BASELINE.is_file() else {}
+    baseline = baselines.setdefault(setup.key, {})
     results, sheet_rows = [], {s.name: [] for s in scenes}
     with tempfile.TemporaryDirectory() as workdir:
         workdir = Path(workdir)
         for medium in args.media:
-            exemplar = load_exemplar(medium, workdir, guide_params)
+            exemplar = load_exemplar(medium, setup.exemplar_size, workdir, guide_params)
             results.append((medium, exemplar.figures, []))
             for scene in scenes:
                 begun = time.perf_counter()
@@ -462,8 +519,8 @@ def main():
     if args.record_baseline:
         for medium, _, measured in results:
             baseline.setdefault(medium, {}).update({name: figures["fidelity"] for name, figures in measured})
-        SHEETS.mkdir(parents=True, exist_ok=True)
-        BASELINE.write_text(json.dumps(baseline, indent=1, sort_keys=True) + "\n")
+        BASELINE.parent.mkdir(parents=True, exist_ok=True)
+        BASELINE.write_text(json.dumps(baselines, indent=1, sort_keys=True) + "\n")
     rows = []
     for medium, reference, measured in results:
         rows.append(exemplar_row(medium, reference))
@@ -477,10 +534,10 @@ def main():
         print(f"  {name:10s} {text}")
     print(f"\n{seconds:.0f} s; load average {loads[0]:.2f} -> {loads[1]:.2f}")
     if args.write_docs:
-        SHEETS.mkdir(parents=True, exist_ok=True)
+        setup.sheets.mkdir(parents=True, exist_ok=True)
         for scene in scenes:
-            contact_sheet(scene, sheet_rows[scene.name], SHEETS / sheet_name(scene))
-        write_docs(command, loads, started, seconds, rows, results, scenes, args.media)
+            contact_sheet(scene, sheet_rows[scene.name], setup.sheets / sheet_name(scene))
+        write_docs(setup, command, loads, started, seconds, rows, results, scenes, args.media)
 
 
 if __name__ == "__main__":
