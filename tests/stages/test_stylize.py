@@ -8,7 +8,7 @@ import pytest
 from scipy import ndimage
 
 from fluidymation.errors import StageError
-from fluidymation.quality import local_contrast
+from fluidymation.quality import gradient_profile, local_contrast
 from fluidymation.stages import exemplar_builtin, exemplar_store, guides, stylize
 
 SIZE = 48
@@ -232,3 +232,21 @@ def test_the_edge_guide_keeps_a_narrow_rim_at_the_edge(tmp_path):
         dark[weight] = last.rgba[..., :3].mean(axis=2) < 0.45
     assert dark[4.0][band].mean() < 0.05 < dark[0.0][band].mean()  # measured 0.027 and 0.109
     assert dark[4.0][rim].mean() > 0.7  # measured 0.80 (0.62 without the edge guide)
+
+
+def test_no_seam_ring_where_the_border_and_interior_segments_meet(tmp_path):
+    """Each segment's histogram remapping applied to its own pixels only stepped at the split (edge
+    distance = border_width): the gradient in the band just inside it was 1.6× the profile's median."""
+    ex = exemplar_builtin.make_builtin_exemplar(exemplar_builtin.Params(
+        preset="watercolor-bloom", seed=0, size=(64, 64), frames=6, color="#2a6fdb", wetness=0.5))
+    split = dataclasses.replace(GUIDES, blur_sigma=3, shape_radius=12, border_width=6)
+    cache = guides.compute_guides(lambda j: ex.mask[j], len(ex.rgb), params=split, cache_dir=tmp_path / "source",
+                                  given_flow=lambda j: ex.flow[j])
+    bloom = exemplar_store.in_memory(ex.rgb, cache)
+    yy, xx = np.mgrid[:64, :64] + 0.5
+    disk = np.clip(26 - np.hypot(yy - 32, xx - 32) + 0.5, 0, 1).astype(np.float32)
+    frames = list(stylize.stylize_sequence(lambda j: disk, 3, bloom, params=stylize.Params(), guide_params=split,
+                                           cache_dir=tmp_path / "target"))
+    profile, _ = gradient_profile([frame.rgba[..., :3] for frame in frames], [disk] * 3)
+    relative = profile / np.median(profile[3:20])
+    assert relative[5] < 1.2  # band 5–6 px, just inside the split: measured 0.67 (1.61 before)
