@@ -96,9 +96,9 @@ def match_histograms(colour: np.ndarray, nnf_frame: np.ndarray, target_segment: 
     values = np.ascontiguousarray(out[matched].T)  # (C, N): one contiguous row per channel
     own = target_segment[matched]
     frames_used = nnf_frame[matched]
-    # each segment's own pixels take their ranks' values (ties keep distinct ranks)
+    # each segment's own pixels take their ranks' values (ties keep distinct ranks); pixels
+    # without a remapping keep theirs
     remapped = values.copy()
-    covered = np.zeros(values.shape[1], bool)
     remappings = {}
     for label in range(labels):
         members = np.flatnonzero(own == label)
@@ -109,22 +109,19 @@ def match_histograms(colour: np.ndarray, nnf_frame: np.ndarray, target_segment: 
         for channel, (order, wanted) in enumerate(remapping):
             own_values[channel, order] = wanted
         remapped[:, members] = own_values
-        covered[members] = True
         remappings[label] = (members, remapping)
     if blend is not None and remappings:
-        _blend_remappings(values, own, blend[:, matched], remappings, remapped, covered)
-    if not covered.all():
-        remapped[:, ~covered] = values[:, ~covered]
+        _blend_remappings(values, own, blend[:, matched], remappings, remapped)
     out[matched] = (values + np.float32(strength) * (remapped - values)).T
     return out
 
 
-def _blend_remappings(values, own, weights, remappings, remapped, covered) -> None:
+def _blend_remappings(values, own, weights, remappings, remapped) -> None:
     """Where a pixel takes some of another segment's remapping, mix them by ``weights`` (labels, N), in place.
 
     ``values`` and ``remapped`` are (C, N). The pixel's own remapping keeps its exact (rank)
     value; another segment's is read as a function of the value. Only segments with a
-    remapping count; ``covered`` gains the pixels that now have a value."""
+    remapping count."""
     available = np.zeros(len(weights), bool)
     available[list(remappings)] = True
     weights = np.where(available[:, None], weights, 0.0).astype(np.float32)
@@ -132,8 +129,8 @@ def _blend_remappings(values, own, weights, remappings, remapped, covered) -> No
     zone = np.flatnonzero(weights.sum(axis=0) > own_weight)
     if zone.size == 0:
         return
-    own_weight = np.where(covered[zone], own_weight[zone], 0.0)
-    mixed = own_weight * np.where(covered[zone], remapped[:, zone], 0.0)
+    own_weight = own_weight[zone]
+    mixed = own_weight * remapped[:, zone]
     total = own_weight.copy()
     for label, (members, remapping) in remappings.items():
         weight = np.where(own[zone] != label, weights[label, zone], 0.0)
@@ -144,7 +141,6 @@ def _blend_remappings(values, own, weights, remappings, remapped, covered) -> No
         total += weight
     has = total > 0
     remapped[:, zone[has]] = mixed[:, has] / total[has]
-    covered[zone[has]] = True
 
 
 def _segment_remapping(values: np.ndarray, frames_used: np.ndarray, table: np.ndarray):
