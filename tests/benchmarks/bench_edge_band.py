@@ -6,7 +6,7 @@ Run: ``NUMBA_CACHE_DIR=.numba-cache .venv/bin/python tests/benchmarks/bench_edge
 Renders layer ``blob`` of ``examples/blob`` (frames 0–24, built-in watercolor-bloom at its
 default size) through the CLI into a temporary folder and prints, over those frames and
 with the layer's alpha as the mask (:mod:`fluidymation.quality`): the edge-gradient
-profile's peak/median over bands 5–40 px and the profile of bands 1–16 over that median,
+profile's peak/median over bands 5–40 px and the profile of bands 1–20 over that median,
 then the local contrast over the exemplar's. ``--crop`` writes frame 24 of the layer over
 paper, 3× enlarged around the blob (the README's before/after of the edge band). Run it
 from a checkout of an older commit to measure the stylizer before a change.
@@ -25,6 +25,7 @@ import numpy as np
 import yaml
 from PIL import Image
 
+from bench_quality import over_paper, overrides, profile_curve
 from fluidymation import quality
 from fluidymation.pipeline import paths
 from fluidymation.pipeline.presets import resolve_params
@@ -43,7 +44,9 @@ def render(workdir: Path, params: dict) -> list[np.ndarray]:
     """The layer's RGBA frames (float, 0–1), rendered by the CLI with ``params`` as the scene's defaults."""
     scene = yaml.safe_load((EXAMPLE / "scene.yaml").read_text())
     scene["layers"] = [layer for layer in scene["layers"] if layer["name"] == "blob"]
-    scene["defaults"] = {"params": params}
+    # a scene takes a list parameter as text ("2, 1")
+    scene["defaults"] = {"params": {name: ", ".join(map(str, value)) if isinstance(value, tuple) else value
+                                    for name, value in params.items()}}
     scene["output"] = {"dir": "out", "video": "blob.mp4"}
     shutil.copy(EXAMPLE / scene["input"], workdir / scene["input"])
     (workdir / "scene.yaml").write_text(yaml.safe_dump(scene))
@@ -60,9 +63,7 @@ def exemplar_contrast() -> float:
 
 
 def crop(frame: np.ndarray) -> Image.Image:
-    alpha = frame[..., 3:]
-    over = frame[..., :3] * alpha + (1 - alpha) * np.array(exemplar_builtin.PAPER_COLOUR, np.float32)
-    part = (np.clip(over[CROP], 0, 1) * 255).astype(np.uint8)
+    part = (np.clip(over_paper(frame)[CROP], 0, 1) * 255).astype(np.uint8)
     return Image.fromarray(part).resize((part.shape[1] * ZOOM, part.shape[0] * ZOOM), Image.LANCZOS)
 
 
@@ -72,18 +73,16 @@ def main():
                         help="a stylizer parameter instead of its default (YAML value; repeatable)")
     parser.add_argument("--crop", type=Path, help="write frame 24's crop here")
     args = parser.parse_args()
-    params = {name: yaml.safe_load(value) for name, value in (item.split("=", 1) for item in args.param)}
+    params = overrides(args.param)
     with tempfile.TemporaryDirectory() as workdir:
         frames = render(Path(workdir), params)
     rgb, masks = [f[..., :3] for f in frames], [f[..., 3] for f in frames]
     profile, counts = quality.gradient_profile(rgb, masks)
     peak, band = quality.profile_peak_ratio(profile, counts)
-    fitting = quality.fitting_bands(counts)
-    median = np.median(profile[fitting.start:fitting.stop])
     contrast = np.mean([quality.local_contrast(frame, mask) for frame, mask in zip(rgb, masks)])
     print(f"params {params or 'defaults'}")
     print(f"profile peak/median (bands 5-40) {peak:.2f} at band {band}")
-    print("bands 1-16 / median:", " ".join(f"{value:.2f}" for value in profile[1:17] / median))
+    print("bands 1-20 / median:", " ".join(f"{value:.2f}" for value in profile_curve(profile, counts)))
     print(f"local contrast / exemplar's {contrast / exemplar_contrast():.2f}")
     if args.crop:
         crop(frames[CROP_FRAME]).save(args.crop)

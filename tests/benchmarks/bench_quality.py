@@ -314,7 +314,8 @@ def markdown_table(rows: list[list[str]]) -> str:
     return "\n".join(lines)
 
 
-def _over_paper(rgba: np.ndarray) -> np.ndarray:
+def over_paper(rgba: np.ndarray) -> np.ndarray:
+    """RGBA composited over the exemplars' paper colour."""
     alpha = rgba[..., 3:4]
     return rgba[..., :3] * alpha + PAPER * (1 - alpha)
 
@@ -338,8 +339,8 @@ def contact_sheet(scene: Scene, rows: list[tuple[np.ndarray, np.ndarray]], path:
     for exemplar_rgb, output in rows:
         difference = 1.0 - np.clip(5.0 * quality.change(output[middle - 1], output[middle]), 0, 1)
         difference = np.where(both[..., None], difference[..., None], PAPER)
-        lines.append(np.concatenate([_tile(exemplar_rgb[middle], output.shape[1]), _over_paper(output[0]), _over_paper(output[middle]),
-                                     _over_paper(output[-1]), difference], axis=1))
+        lines.append(np.concatenate([_tile(exemplar_rgb[middle], output.shape[1]), over_paper(output[0]),
+                                     over_paper(output[middle]), over_paper(output[-1]), difference], axis=1))
     sheet = (np.clip(np.concatenate(lines, axis=0), 0, 1) * 255 + 0.5).astype(np.uint8)
     Image.fromarray(sheet).save(path, quality=SHEET_QUALITY)
 
@@ -466,7 +467,7 @@ frames over paper, and the change into the middle frame where both frames are in
 """)
 
 
-def _overrides(items: list[str]) -> dict:
+def overrides(items: list[str]) -> dict:
     """``NAME=VALUE`` options as keyword arguments, each value read as YAML (``opt_iters=[4, 2, 2]``)."""
     pairs = [item.split("=", 1) for item in items]
     if any(len(pair) != 2 for pair in pairs):
@@ -500,8 +501,8 @@ def main():
     started = datetime.datetime.now().strftime("%Y-%m-%d %H:%M")
     clock, load_start = time.perf_counter(), os.getloadavg()
     print(f"{command}\nload average {load_start[0]:.2f} {load_start[1]:.2f} {load_start[2]:.2f}", flush=True)
-    params = dataclasses.replace(default_params(get_stylizer("fluidymation")), **_overrides(args.param))
-    guide_params = guides.Params(**_overrides(args.guide))
+    params = dataclasses.replace(default_params(get_stylizer("fluidymation")), **overrides(args.param))
+    guide_params = guides.Params(**overrides(args.guide))
     baselines = json.loads(BASELINE.read_text()) if BASELINE.is_file() else {}
     baseline = baselines.setdefault(setup.key, {})
     results, sheet_rows = [], {s.name: [] for s in scenes}
