@@ -344,10 +344,10 @@ def merge_nnf(first, second, first_error, second_error):
     Returns
     -------
     merged : NNF
-    merged_error : ndarray, shape (H, W), float32
+    took_second : ndarray, shape (H, W), bool
+        Where ``merged`` holds ``second``'s match.
     """
     take_second = (second.frame >= 0) & ((first.frame < 0) | (second_error < first_error))
     frame = np.where(take_second, second.frame, first.frame).astype(np.int32)
     coords = np.where(take_second[:, :, None], second.coords, first.coords).astype(np.float32)
-    error = np.where(take_second, second_error, first_error).astype(np.float32)
-    return NNF(frame, coords), error
+    return NNF(frame, coords), take_second

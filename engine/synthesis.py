@@ -17,6 +17,7 @@ over a long source keeps the frames it has prepared (:meth:`PreparedSource.frame
 from __future__ import annotations
 
 import dataclasses
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -161,6 +162,29 @@ class SynthesisInputs:
     initial_nnf: NNF | None = None
 
 
+class _FinestVote:
+    """The finest level's colour (its vote, when still owed) and the patch errors against it,
+    each computed when first asked for: a settle pass wants only the NNF, a stylized frame no
+    errors."""
+
+    def __init__(self, colour, cost, nnf, pixels):
+        self._colour = colour  # a zero-argument function that votes (and sets the cost's target colour)
+        self._cost = cost
+        self._nnf = nnf
+        self._pixels = pixels
+
+    @functools.cached_property
+    def image(self):
+        with threads_for(self._pixels):
+            return self._colour()
+
+    @functools.cached_property
+    def error(self):
+        self.image  # the errors are against the final colour
+        with threads_for(self._pixels):
+            return patch_errors(self._cost, self._nnf)
+
+
 @dataclass(frozen=True)
 class SynthesisResult:
     """Output of :func:`synthesize`.
@@ -171,11 +195,20 @@ class SynthesisResult:
     nnf : NNF
     error : ndarray, shape (H, W), float32
         Final patch cost per pixel (without the uniformity penalty); inf where unmatched.
+
+    ``image`` and ``error`` are computed when first read.
     """
 
-    image: np.ndarray
     nnf: NNF
-    error: np.ndarray
+    finest: _FinestVote = dataclasses.field(repr=False)
+
+    @property
+    def image(self):
+        return self.finest.image
+
+    @property
+    def error(self):
+        return self.finest.error
 
     def mean_error(self):
         """Mean final patch cost over matched pixels."""
@@ -516,14 +549,13 @@ def _synthesize(source, target, params, target_guides):
                 uniformity_scale=uniformity_scales[level], keep_margin=keep_margins[level],
                 histogram_blend=histogram_blends[level],
             )
-    with threads_for(height * width):
-        error = patch_errors(cost, nnf)
-    return SynthesisResult(image=colour, nnf=nnf, error=error)
+    return SynthesisResult(nnf=nnf, finest=_FinestVote(colour, cost, nnf, height * width))
 
 
 def _synthesize_level(prepared, target, params, *, rank, level, nnf, optimise, target_guides, weight_maps, target_angle,
                       target_segment, uniformity_scale, keep_margin, histogram_blend):
-    """One pyramid level: start from ``nnf`` (the coarser level's, or None), return (nnf, colour, cost)."""
+    """One pyramid level: start from ``nnf`` (the coarser level's, or None), return (nnf, colour, cost), where
+    colour is a function giving the level's colour (a last vote still owed is made when it is called)."""
     rotation_mode = _ROTATIONS[params.rotation]
     level_height, level_width = target_guides.shape[:2]
     level_source_shape = prepared.colour.shape[1:3]
@@ -559,6 +591,10 @@ def _synthesize_level(prepared, target, params, *, rank, level, nnf, optimise, t
         return field
 
     random_start = nnf is None and target.initial_nnf is None
+    # the propagation-only finest level searches against the vote the merge was judged by, with
+    # the merge's errors (one vote, remapping and error pass fewer)
+    propagate_only = not optimise and params.finest_propagation_passes > 0
+    error = None
     if nnf is None:
         nnf = downscaled_initial() if target.initial_nnf is not None else NNF.empty(level_height, level_width)
         repair(nnf, _salt(level, 0, 0, 0))
@@ -569,30 +605,35 @@ def _synthesize_level(prepared, target, params, *, rank, level, nnf, optimise, t
             revote()
             other = downscaled_initial()
             held_error = patch_errors(cost, other)
+            compared = held_error
             if keep_margin is not None:
-                held_error = held_error * np.where(np.isfinite(held_error), 1.0 - keep_margin, 1.0).astype(np.float32)
-            nnf, _ = merge_nnf(nnf, other, patch_errors(cost, nnf), held_error)
-    colour = revote()
+                compared = held_error * np.where(np.isfinite(held_error), 1.0 - keep_margin, 1.0).astype(np.float32)
+            upscaled_error = patch_errors(cost, nnf)
+            nnf, took_held = merge_nnf(nnf, other, upscaled_error, compared)
+            error = np.where(took_held, held_error, upscaled_error)
+    if error is None or not propagate_only:
+        colour = revote()
+        error = None
 
     if random_start and params.guided_initialization:
         guides_cost = cost.guides_only()
-        error = patch_errors(guides_cost, nnf)
+        guides_error = patch_errors(guides_cost, nnf)
         for iteration in range(_schedule(params.patchmatch_iters, rank)):
-            patchmatch_pass(guides_cost, nnf, error, rotation_mode=rotation_mode, alpha=params.alpha,
+            patchmatch_pass(guides_cost, nnf, guides_error, rotation_mode=rotation_mode, alpha=params.alpha,
                             seed=params.seed, salt=_salt(level, 2, 0, iteration), reverse=iteration % 2 == 1,
                             tile_rows=params.tile_rows)
         colour = revote()
 
-    if not optimise and params.finest_propagation_passes == 0:
-        return nnf, colour, cost
+    if not optimise and not propagate_only:
+        return nnf, functools.partial(_same, colour), cost
     scales = None
     if params.uniformity_weight > 0:
         scales = budget_scales(source_segment=cost.source_segment, target_segment=cost.target_segment,
                                patch_size=params.patch_size, frame_radius=params.uniformity_radius,
                                weight=params.uniformity_weight)
 
-    def search(passes, phase, em, random_search):
-        error = patch_errors(cost, nnf)
+    def search(passes, phase, em, random_search, error=None):
+        error = patch_errors(cost, nnf) if error is None else error
         for iteration in range(passes):
             penalty = None
             if scales is not None:
@@ -605,13 +646,18 @@ def _synthesize_level(prepared, target, params, *, rank, level, nnf, optimise, t
                             seed=params.seed, salt=_salt(level, phase, em, iteration), reverse=iteration % 2 == 1,
                             tile_rows=params.tile_rows)
 
-    if not optimise:
-        search(params.finest_propagation_passes, 4, 0, random_search=False)
-        return nnf, revote(), cost
+    if propagate_only:
+        search(params.finest_propagation_passes, 4, 0, random_search=False, error=error)
+        return nnf, revote, cost
     for em in range(_schedule(params.search_vote_iters, rank)):
         search(_schedule(params.patchmatch_iters, rank), 3, em, random_search=True)
         colour = revote()
-    return nnf, colour, cost
+    return nnf, functools.partial(_same, colour), cost
+
+
+def _same(value):
+    """``value`` itself: the colour function of a level whose last vote is made."""
+    return value
 
 
 def _salt(level, phase, em, iteration):

@@ -205,7 +205,7 @@ def window_start(step: int, steps: int, exemplar_frames: int, window: int) -> in
 
 
 class StylizedFrame(NamedTuple):
-    """One synthesized frame: its index in the sequence, RGBA (H, W, 4) float32, the NNF and its mean error.
+    """One synthesized frame: its index in the sequence, RGBA (H, W, 4) float32 and the NNF.
 
     ``backlog`` (H, W) float32 is the motion not yet followed, carried to the next frame;
     with ``nnf`` it is the state a resumed run needs (``stylize_sequence(resume=...)``).
@@ -214,7 +214,6 @@ class StylizedFrame(NamedTuple):
     index: int
     rgba: np.ndarray
     nnf: NNF
-    mean_error: float
     backlog: np.ndarray
 
 
@@ -432,7 +431,7 @@ def _stylize_step(sequence: _Sequence, k: int, index: int, mask, previous: _Prev
         unchanged = _unchanged_paint(result.nnf, previous.nnf, sequence.params.patch_size)
         rgb = np.where(unchanged[..., None], previous.rgb, np.clip(result.image, 0.0, 1.0))
     rgba = np.concatenate([rgb, coverage[..., None]], axis=2)
-    stylized = StylizedFrame(index=index, rgba=rgba, nnf=result.nnf, mean_error=result.mean_error(), backlog=backlog)
+    stylized = StylizedFrame(index=index, rgba=rgba, nnf=result.nnf, backlog=backlog)
     return stylized, _Previous(result.nnf, inside, frame.ext_plus, backlog, rgb)
 
 

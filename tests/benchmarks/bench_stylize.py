@@ -1,7 +1,7 @@
 """Benchmark: the stylize stage at the sizes of issue 6, next to the paper's Table 2.
 
 Run: ``.venv/bin/python tests/benchmarks/bench_stylize.py [--cases speed memory window] [--threads 2]
-[--profile]``.
+[--profile] [--param NAME=VALUE ...]``.
 
 * speed: a 500×600 target with ~60 000 masked pixels (an ellipse drifting and turning)
   for 6 frames, the built-in ``watercolor-bloom`` at 200×200×20 as exemplar — the size of
@@ -21,7 +21,8 @@ stage computes the target guides of the whole sequence and prepares the exemplar
 its first frame, so the first frame's time includes them (the guides are also timed on
 their own beforehand); later frames are synthesis only. Parameters are
 configs/fluidymation.yaml's; exemplars are taken from (or generated into) the user cache.
-``--profile`` prints the child's cProfile.
+``--profile`` prints the child's cProfile; ``--param`` times a stylizer parameter other than its
+default (e.g. ``--param finest_propagation=0``), to weigh what a part of the method costs.
 """
 
 from __future__ import annotations
@@ -38,6 +39,7 @@ from pathlib import Path
 
 import numpy as np
 from bench_guides import blob_masks  # tests/benchmarks is on the path when run as a script
+from bench_quality import overrides
 
 PAPER_SECONDS_PER_FRAME = 1.33
 CASES = {
@@ -98,16 +100,17 @@ def target_masks(shape, width, height):
     return (ellipse_masks if shape == "ellipse" else blob_masks)(width, height)
 
 
-def run_case(name, profile, window=None, stored=None):
-    """Child process: run one case (with ``source_window`` ``window``; the exemplar stored in ``stored``,
-    or generated here), print one JSON line with its figures."""
+def run_case(name, profile, window=None, stored=None, changed=()):
+    """Child process: run one case (with ``source_window`` ``window``, the parameters ``changed``
+    (``NAME=VALUE`` texts); the exemplar stored in ``stored``, or generated here), print one JSON
+    line with its figures."""
     from fluidymation.pipeline.parameters import default_params
     from fluidymation.pipeline.stylizers import get_stylizer
     from fluidymation.stages import exemplar_store, guides, stylize
 
     (width, height), frame_count, (ex_width, ex_height, ex_frames), shape = CASES[name]
     defaults = default_params(get_stylizer("fluidymation"))
-    params = dataclasses.replace(defaults, source_window=window)
+    params = dataclasses.replace(defaults, source_window=window, **overrides(list(changed)))
     guide_params = guides.Params()
     masks = target_masks(shape, width, height)
     with tempfile.TemporaryDirectory() as folder:
@@ -160,9 +163,10 @@ def run_case(name, profile, window=None, stored=None):
                       "peak": peak_and_current_rss_mib()[0], "loads": loads}))
 
 
-def run_child(name, threads, profile, window=None, stored=None):
+def run_child(name, threads, profile, window=None, stored=None, changed=()):
     env = dict(os.environ, NUMBA_NUM_THREADS=str(threads))
     command = [sys.executable, __file__, "--child", name] + (["--profile"] if profile else [])
+    command += [f"--param={item}" for item in changed]
     command += [] if window is None else ["--window", str(window)]
     command += [] if stored is None else ["--stored", str(stored)]
     result = subprocess.run(command, env=env, stdout=subprocess.PIPE, text=True)
@@ -199,16 +203,20 @@ def main():
     parser.add_argument("--cases", nargs="*", default=list(CASES), choices=list(CASES))
     parser.add_argument("--threads", type=int, default=2)
     parser.add_argument("--profile", action="store_true", help="print each case's cProfile (cumulative)")
+    parser.add_argument("--param", action="append", default=[], metavar="NAME=VALUE",
+                        help="a stylizer parameter instead of its default (YAML value; repeatable)")
     parser.add_argument("--child", choices=list(CASES), help=argparse.SUPPRESS)
     parser.add_argument("--window", type=int, help=argparse.SUPPRESS)
     parser.add_argument("--stored", help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.child:
-        run_case(args.child, args.profile, args.window, args.stored)
+        run_case(args.child, args.profile, args.window, args.stored, args.param)
         return
+    if args.param:
+        print("parameters other than configs/fluidymation.yaml's: " + ", ".join(args.param))
     for name in args.cases:
         if name not in WINDOWS:
-            report(name, run_child(name, args.threads, args.profile), args.threads)
+            report(name, run_child(name, args.threads, args.profile, changed=args.param), args.threads)
             continue
         from fluidymation.stages import guides
 
@@ -216,7 +224,8 @@ def main():
         with tempfile.TemporaryDirectory() as stored:  # stored here, so no run holds the generated exemplar
             exemplar_source(ex_width, ex_height, ex_frames, guides.Params(), stored, stored=True)
             for window in WINDOWS[name]:
-                report(name, run_child(name, args.threads, args.profile, window, stored), args.threads, window)
+                report(name, run_child(name, args.threads, args.profile, window, stored, args.param), args.threads,
+                       window)
 
 
 if __name__ == "__main__":

@@ -81,9 +81,10 @@ def test_downscale_takes_the_mode_and_skips_unmatched():
 def test_merge_keeps_the_lower_error():
     a = NNF(np.zeros((1, 3), np.int32), np.zeros((1, 3, 3), np.float32))
     b = NNF(np.array([[1, 1, -1]], np.int32), np.ones((1, 3, 3), np.float32))
-    merged, error = merge_nnf(a, b, np.array([[1.0, 0.5, 9.0]], np.float32), np.array([[0.5, 0.5, 0.0]], np.float32))
+    merged, took_second = merge_nnf(a, b, np.array([[1.0, 0.5, 9.0]], np.float32),
+                                    np.array([[0.5, 0.5, 0.0]], np.float32))
     assert merged.frame.tolist() == [[1, 0, 0]]
-    assert error.tolist() == [[0.5, 0.5, 9.0]]
+    assert took_second.tolist() == [[True, False, False]]
 
 
 def test_random_fill_respects_segments_and_is_deterministic():

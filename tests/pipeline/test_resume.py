@@ -65,7 +65,7 @@ def test_a_killed_render_resumes_without_redoing_frames_and_matches_an_uninterru
 def _state(index, value):
     nnf = NNF(np.full((2, 2), index, np.int32), np.full((2, 2, 3), value, np.float32))
     rgba = np.full((2, 2, 4), value, np.float32)
-    return StylizedFrame(index=index, rgba=rgba, nnf=nnf, mean_error=0.0, backlog=np.full((2, 2), value, np.float32))
+    return StylizedFrame(index=index, rgba=rgba, nnf=nnf, backlog=np.full((2, 2), value, np.float32))
 
 
 def test_the_resume_point_is_the_longest_finished_prefix_with_a_saved_state(tmp_path):
