@@ -263,3 +263,15 @@ def naive_shift_frames(frames, coords, motion, target_angle, ext_plus, ext_minus
             options = [(abs(motion[ty, tx] - (ext_plus[k, sy, sx] - ext_plus[i, sy, sx])), k - i, k) for k in range(i, count)]
         out[ty, tx] = min(options)[2]
     return out
+
+
+def naive_inside(rings, x, y, even_odd):
+    """Whether point (x, y) is inside closed polygon rings, by the winding number of each edge crossing a ray to +x."""
+    winding = 0
+    for ring in rings:
+        for (x0, y0), (x1, y1) in zip(ring, ring[1:] + ring[:1]):
+            if (y0 <= y) != (y1 <= y):
+                crossing = x0 + (y - y0) / (y1 - y0) * (x1 - x0)
+                if crossing > x:
+                    winding += 1 if y1 > y0 else -1
+    return winding % 2 != 0 if even_odd else winding != 0

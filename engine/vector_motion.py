@@ -1,0 +1,193 @@
+"""Motion fields from the vector geometry itself (issue 16; docs/guides.md, "Motion from the geometry").
+
+A reader evaluates each drawn element (a filled path) at two frames: its outline at frame
+j and, for every outline point, where that same point of the element was at frame j − 1
+(the same vertex or curve parameter, carried through every transform: parenting, groups,
+path keyframes). That is all this module needs, so it knows no file format and no renderer.
+
+Per element, the point displacements ``d = now − before`` are fitted by an affine motion
+``d(p) = b + A·p`` (least squares, each point weighted by the outline length it stands
+for). A rigid, scaled or sheared part is exactly affine, so its whole interior reads its
+motion exactly, points on the rotation axis included. What the fit does not explain (a
+path that deforms) is left at the outline points and filled smoothly into the interior by
+Laplace's equation (:func:`fluidymation.engine.flow.harmonic_fill`); affine fields are
+harmonic, so the two parts add up to the harmonic interpolation of the outline's motion.
+
+Elements are composited bottom to top: a pixel takes the motion of the topmost element
+covering its centre. Flows are float32 ``(H, W, 2)`` holding ``(dx, dy)`` in px/frame, y
+down, and, as elsewhere, ``flow[j]`` is the motion that brought the material to frame j.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from fluidymation.engine._jit import kernel
+from fluidymation.engine.flow import harmonic_fill
+
+
+@dataclass(frozen=True)
+class MovingElement:
+    """One filled element at frame j and where its outline points were at frame j − 1.
+
+    Attributes
+    ----------
+    now, before : ndarray, shape (N, 2), float32
+        Outline points ``(x, y)`` in pixels at frame j and the same points at frame j − 1.
+    ring_starts : ndarray, shape (R + 1,), int64
+        Point ``ring_starts[r]`` up to ``ring_starts[r + 1]`` form closed ring r (an outline
+        or a hole; the last point joins the first).
+    even_odd : bool
+        The element's fill rule: even-odd, or nonzero winding.
+    """
+
+    now: np.ndarray
+    before: np.ndarray
+    ring_starts: np.ndarray
+    even_odd: bool = False
+
+    def __post_init__(self):
+        now = np.ascontiguousarray(self.now, np.float32)
+        before = np.ascontiguousarray(self.before, np.float32)
+        starts = np.ascontiguousarray(self.ring_starts, np.int64)
+        if now.ndim != 2 or now.shape[1] != 2 or before.shape != now.shape:
+            raise ValueError(f"now and before must both be (N, 2), got {now.shape} and {before.shape}")
+        if starts.ndim != 1 or starts.size < 2 or starts[0] != 0 or starts[-1] != now.shape[0] or np.any(
+                np.diff(starts) < 0):
+            raise ValueError("ring_starts must rise from 0 to the number of points")
+        object.__setattr__(self, "now", now)
+        object.__setattr__(self, "before", before)
+        object.__setattr__(self, "ring_starts", starts)
+
+
+@kernel
+def _coverage(points, ring_starts, even_odd, out):
+    """Mark the pixels whose centre lies inside the rings (scanline crossings per pixel row)."""
+    height, width = out.shape
+    total = points.shape[0]
+    crossings = np.empty(total, np.float64)
+    directions = np.empty(total, np.int64)
+    for row in range(height):
+        y = row + 0.5
+        count = 0
+        for ring in range(ring_starts.shape[0] - 1):
+            first = ring_starts[ring]
+            last = ring_starts[ring + 1]
+            for i in range(first, last):
+                j = i + 1 if i + 1 < last else first
+                y0 = points[i, 1]
+                y1 = points[j, 1]
+                if (y0 <= y) == (y1 <= y):  # half-open: a vertex on the line counts once
+                    continue
+                t = (y - y0) / (y1 - y0)
+                crossings[count] = points[i, 0] + t * (points[j, 0] - points[i, 0])
+                directions[count] = 1 if y1 > y0 else -1
+                count += 1
+        if count == 0:
+            continue
+        order = np.argsort(crossings[:count])
+        winding = 0
+        for k in range(count - 1):
+            winding += directions[order[k]]
+            inside = (winding % 2 != 0) if even_odd else winding != 0
+            if not inside:
+                continue
+            start = max(int(np.ceil(crossings[order[k]] - 0.5)), 0)
+            stop = min(int(np.ceil(crossings[order[k + 1]] - 0.5)), width)
+            for column in range(start, stop):
+                out[row, column] = True
+
+
+def coverage(element: MovingElement, shape: tuple[int, int]) -> np.ndarray:
+    """(H, W) bool: the pixels whose centre the element covers at frame j."""
+    out = np.zeros(shape, bool)
+    _coverage(element.now.astype(np.float64), element.ring_starts, bool(element.even_odd), out)
+    return out
+
+
+def _point_weights(element: MovingElement) -> np.ndarray:
+    """Half the length of the two outline segments at each point: the share of the outline it stands for."""
+    weights = np.zeros(element.now.shape[0], np.float64)
+    for first, last in zip(element.ring_starts[:-1], element.ring_starts[1:]):
+        ring = element.now[first:last].astype(np.float64)
+        if ring.shape[0] == 0:
+            continue
+        lengths = np.linalg.norm(np.roll(ring, -1, axis=0) - ring, axis=1)
+        weights[first:last] = 0.5 * (lengths + np.roll(lengths, 1))
+    return weights
+
+
+def affine_fit(element: MovingElement) -> np.ndarray:
+    """The affine motion ``d(p) = M @ (x, y, 1)`` best fitting the outline's displacements, M (2, 3).
+
+    Weighted least squares; with fewer than three independent points (a degenerate
+    outline) the fit falls back to the mean displacement.
+    """
+    now = element.now.astype(np.float64)
+    moved = now - element.before.astype(np.float64)
+    weights = _point_weights(element)
+    if weights.sum() <= 0.0:
+        weights = np.ones_like(weights)
+    design = np.column_stack([now, np.ones(now.shape[0])]) * np.sqrt(weights)[:, None]
+    target = moved * np.sqrt(weights)[:, None]
+    if np.linalg.matrix_rank(design) < 3:
+        mean = (moved * weights[:, None]).sum(axis=0) / weights.sum()
+        return np.array([[0.0, 0.0, mean[0]], [0.0, 0.0, mean[1]]])
+    solution, *_ = np.linalg.lstsq(design, target, rcond=None)
+    return solution.T
+
+
+def element_flow(element: MovingElement, covered: np.ndarray, *, sweeps: int = 8) -> np.ndarray:
+    """(H, W, 2) float32: the element's motion at every pixel (meaningful where ``covered``).
+
+    The affine fit everywhere, plus, where the outline deforms beyond it, the harmonic fill
+    of the residual displacements from the outline points into ``covered``.
+    """
+    height, width = covered.shape
+    matrix = affine_fit(element)
+    yy, xx = np.mgrid[:height, :width].astype(np.float64) + 0.5
+    flow = np.stack([
+        matrix[0, 0] * xx + matrix[0, 1] * yy + matrix[0, 2],
+        matrix[1, 0] * xx + matrix[1, 1] * yy + matrix[1, 2],
+    ], axis=2)
+    now = element.now.astype(np.float64)
+    residual = (now - element.before) - (np.column_stack([now, np.ones(now.shape[0])]) @ matrix.T)
+    if np.abs(residual).max(initial=0.0) > 1e-3:
+        values, fixed = _splat_outline(now, residual, (height, width))
+        domain = covered | fixed
+        flow += harmonic_fill(values, fixed, domain, sweeps=sweeps)
+    return flow.astype(np.float32)
+
+
+def _splat_outline(points: np.ndarray, residual: np.ndarray, shape: tuple[int, int]):
+    """The outline's residual displacements on the pixels nearest its points (mean where several meet)."""
+    height, width = shape
+    columns = np.clip(np.floor(points[:, 0]).astype(np.int64), 0, width - 1)
+    rows = np.clip(np.floor(points[:, 1]).astype(np.int64), 0, height - 1)
+    index = rows * width + columns
+    counts = np.bincount(index, minlength=height * width)
+    values = np.zeros((height * width, 2), np.float64)
+    for axis in range(2):
+        values[:, axis] = np.bincount(index, weights=residual[:, axis], minlength=height * width)
+    fixed = counts > 0
+    values[fixed] /= counts[fixed][:, None]
+    return values.reshape(height, width, 2).astype(np.float32), fixed.reshape(height, width)
+
+
+def vector_flow(elements: list[MovingElement], shape: tuple[int, int]) -> tuple[np.ndarray, np.ndarray]:
+    """The motion of the topmost element at each pixel, elements given bottom to top.
+
+    Returns ``(flow, owned)``: (H, W, 2) float32, zero where no element covers a pixel, and
+    (H, W) bool, the pixels some element covers.
+    """
+    flow = np.zeros(tuple(shape) + (2,), np.float32)
+    owned = np.zeros(tuple(shape), bool)
+    for element in elements:
+        covered = coverage(element, shape)
+        if not covered.any():
+            continue
+        flow[covered] = element_flow(element, covered)[covered]
+        owned |= covered
+    return flow, owned
