@@ -141,7 +141,27 @@ def _unit(vector: tuple[float, float]) -> tuple[float, float]:
 
 def _drawing_polylines(path: PathData) -> tuple[list[list[tuple[float, float, float, float]]], tuple[float, float]]:
     """Each drawing command of ``path`` as a polyline of (x, y, tangent x, tangent y), absolute; the first point."""
-    polylines = []
+    polylines, _, first = _drawing_segments(path)
+    return polylines, first
+
+
+def subpath_rings(path: PathData) -> list[list[tuple[float, float]]]:
+    """Each subpath of ``path`` as a closed ring of absolute points (as a fill closes it).
+
+    Every command is cut into the same number of pieces whatever its arguments, so the same
+    path at two times, command for command, gives rings whose points correspond.
+    """
+    polylines, subpaths, _ = _drawing_segments(path)
+    rings: dict[int, list[tuple[float, float]]] = {}
+    for polyline, subpath in zip(polylines, subpaths):
+        ring = rings.setdefault(subpath, [polyline[0][:2]])
+        ring.extend(point[:2] for point in polyline[1:])
+    return [ring for ring in rings.values() if len(ring) >= 3]
+
+
+def _drawing_segments(path: PathData):
+    """(polylines, the subpath number of each, the first point) of :func:`_drawing_polylines`."""
+    polylines, subpaths, subpath = [], [], -1
     x = y = start_x = start_y = 0.0
     control = None  # the last curve's second control point, for S and T
     first = None
@@ -152,6 +172,7 @@ def _drawing_polylines(path: PathData) -> tuple[list[list[tuple[float, float, fl
             x, y = values[0] + dx, values[1] + dy
             start_x, start_y, control = x, y, None
             first = first or (x, y)
+            subpath += 1
             continue
         if kind == "Z":
             end = (start_x, start_y)
@@ -177,8 +198,11 @@ def _drawing_polylines(path: PathData) -> tuple[list[list[tuple[float, float, fl
         if kind not in "CSQT":
             control = None
         polylines.append(curve)
+        subpaths.append(subpath)
         x, y = end
-    return polylines, first or (0.0, 0.0)
+        if kind == "Z":  # a drawing command after closepath starts a new subpath at the same point
+            subpath += 1
+    return polylines, subpaths, first or (0.0, 0.0)
 
 
 def _line(start, end) -> list[tuple[float, float, float, float]]:

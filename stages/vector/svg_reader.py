@@ -116,13 +116,17 @@ def _layer_names(root: ElementTree.Element) -> list[str]:
     return [name for _, name in _top_layers(root)]
 
 
-def _hide_other_layers(root: ElementTree.Element, names: list[str]) -> bytes:
-    """The SVG of ``root`` (changed in place) with every top-level drawable element but the layers ``names`` hidden."""
+def _hide_other_layers(root: ElementTree.Element, names: list[str]) -> ElementTree.Element:
+    """``root`` (changed in place) with every top-level drawable element but the layers ``names`` hidden."""
     keep = set(names)
     kept = {id(element) for element, name in _top_layers(root) if name in keep}
     for element in root:
         if local_name(element.tag) in _DRAWN and id(element) not in kept:
             set_style_property(element, "display", "none")
+    return root
+
+
+def _svg_bytes(root: ElementTree.Element) -> bytes:
     ElementTree.register_namespace("", SVG_NAMESPACE)
     return ElementTree.tostring(root)
 
@@ -209,7 +213,11 @@ class SvgDocument(VectorDocument):
         return 0, frames_in(max(animation.duration() for animation in self.animations), fps)
 
     def isolate(self, names, time_seconds) -> SvgFrame:
-        return SvgFrame(_hide_other_layers(_at_time(self.root, self.animations, time_seconds), names), str(self.path))
+        return SvgFrame(_svg_bytes(self.static_tree(names, time_seconds)), str(self.path))
+
+    def static_tree(self, names, time_seconds) -> ElementTree.Element:
+        """The document as shown at ``time_seconds`` (animations applied), only the layers ``names`` displayed."""
+        return _hide_other_layers(_at_time(self.root, self.animations, time_seconds), names)
 
 
 class SvgSequenceDocument(VectorDocument):
@@ -235,12 +243,19 @@ class SvgSequenceDocument(VectorDocument):
         return 0, len(self.files)
 
     def isolate(self, names, time_seconds) -> SvgFrame:
+        return SvgFrame(_svg_bytes(self.static_tree(names, time_seconds)), str(self._file_at(time_seconds)))
+
+    def static_tree(self, names, time_seconds) -> ElementTree.Element:
+        """The file of the frame at ``time_seconds`` (its CSS resolved), only the layers ``names`` displayed."""
+        path = self._file_at(time_seconds)
+        root = load_svg(path)  # its CSS transforms are resolved even when nothing moves
+        return _hide_other_layers(_at_time(root, _animations(root, str(path)), 0.0), names)
+
+    def _file_at(self, time_seconds) -> Path:
         frame = math.floor(time_seconds * self.fps + 1e-6)
         if not 0 <= frame < len(self.files):
             raise InputError(f"{self.path}: frame {frame} is outside the sequence (0 to {len(self.files) - 1})")
-        path = self.files[frame]
-        root = load_svg(path)  # its CSS transforms are resolved even when nothing moves
-        return SvgFrame(_hide_other_layers(_at_time(root, _animations(root, str(path)), 0.0), names), str(path))
+        return self.files[frame]
 
 
 def _animations(root: ElementTree.Element, source: str) -> tuple[Animation, ...]:

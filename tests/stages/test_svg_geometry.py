@@ -1,0 +1,98 @@
+import math
+
+import numpy as np
+import pytest
+
+from fluidymation.engine.vector_motion import vector_flow
+from fluidymation.stages.vector import open_document
+from fluidymation.stages.vector.svg_geometry import moving_elements, outlines
+
+FPS = 24.0
+SIZE = (64, 64)
+
+
+def _write(tmp_path, body, view="0 0 64 64"):
+    path = tmp_path / "shape.svg"
+    path.write_text(f'<svg xmlns="http://www.w3.org/2000/svg" width="64" height="64" viewBox="{view}">{body}</svg>')
+    return open_document(path, fps=FPS)
+
+
+def _flow(document, frame, size=SIZE):
+    names = document.layer_names()
+    elements, unread = moving_elements(document.static_tree(names, (frame - 1) / FPS),
+                                       document.static_tree(names, frame / FPS), size)
+    flow, owned = vector_flow(elements, (size[1], size[0]))
+    return flow, owned, unread
+
+
+def _gear(centre, inner, outer, teeth=8):
+    points = []
+    for k in range(4 * teeth):
+        radius = outer if k % 4 in (1, 2) else inner
+        angle = 2 * math.pi * k / (4 * teeth)
+        points.append(f"{centre[0] + radius * math.cos(angle):.4f},{centre[1] + radius * math.sin(angle):.4f}")
+    return "M" + " L".join(points) + " Z"
+
+
+def _assert_turning(flow, owned, centre, degrees_per_frame, clockwise=True):
+    omega = math.radians(degrees_per_frame)
+    yy, xx = np.nonzero(owned)
+    offset = np.column_stack([xx + 0.5, yy + 0.5]) - np.asarray(centre)
+    radius = np.hypot(offset[:, 0], offset[:, 1])
+    away = radius > 3.0
+    speed = np.hypot(*flow[yy, xx].T)
+    np.testing.assert_allclose(speed[away], omega * radius[away], rtol=0.05)
+    # a positive SVG rotation turns x towards y: clockwise on screen, tangent (−y, x)
+    tangent = np.arctan2(offset[:, 0], -offset[:, 1]) + (0.0 if clockwise else math.pi)
+    turn = np.angle(np.exp(1j * (np.arctan2(flow[yy, xx, 1], flow[yy, xx, 0]) - tangent)))
+    assert np.degrees(np.abs(turn[away])).max() < 5.0
+
+
+@pytest.mark.parametrize("shape", ["disk", "gear"])
+def test_a_smil_rotation_reads_omega_r_along_the_tangent(tmp_path, shape):
+    drawn = ('<circle cx="32" cy="32" r="24"/>' if shape == "disk" else f'<path d="{_gear((32, 32), 18, 26)}"/>')
+    document = _write(tmp_path, f'<g id="wheel">{drawn}<animateTransform attributeName="transform" type="rotate" '
+                                'from="0 32 32" to="360 32 32" dur="3s" repeatCount="indefinite"/></g>')
+    flow, owned, unread = _flow(document, 5)
+    assert unread == []
+    _assert_turning(flow, owned, (32, 32), 360 / (3 * FPS))
+
+
+def test_a_css_rotation_in_a_scaled_viewbox_reads_in_output_pixels(tmp_path):
+    document = _write(tmp_path, '<style>#gear { transform-origin: 16px 16px; animation: spin 2s linear infinite } '
+                                '@keyframes spin { to { transform: rotate(-360deg) } }</style>'
+                                f'<path id="gear" d="{_gear((16, 16), 9, 13)}"/>', view="0 0 32 32")
+    flow, owned, unread = _flow(document, 3, size=(128, 128))
+    assert unread == []
+    _assert_turning(flow, owned, (64, 64), 360 / (2 * FPS), clockwise=False)
+
+
+def test_a_scaling_square_reads_the_analytic_field(tmp_path):
+    document = _write(tmp_path, '<rect x="12" y="12" width="40" height="40"><animateTransform '
+                                'attributeName="transform" type="scale" from="1" to="1.5" dur="1s" fill="freeze"/></rect>')
+    flow, owned, _ = _flow(document, 6)
+    yy, xx = np.nonzero(owned)
+    now, before = 1 + 0.5 * 6 / FPS, 1 + 0.5 * 5 / FPS  # scaling about the origin
+    expected = np.column_stack([xx + 0.5, yy + 0.5]) * (1.0 - before / now)
+    np.testing.assert_allclose(flow[yy, xx], expected, atol=1e-3)
+
+
+def test_a_path_morph_moves_with_its_vertices(tmp_path):
+    document = _write(tmp_path, '<path d="M10,10 L40,10 L40,40 L10,40 Z"><animate attributeName="d" dur="1s" '
+                                'values="M10,10 L40,10 L40,40 L10,40 Z;M10,10 L58,10 L58,40 L10,40 Z" '
+                                'fill="freeze"/></path>')
+    flow, owned, unread = _flow(document, 12)
+    assert unread == []
+    step = 18 / FPS  # the right edge's speed, px/frame; the left edge stands
+    assert flow[25, 45, 0] == pytest.approx(step * (45.5 - 10) / (10 + 30 + 18 * 12 / FPS - 10), rel=0.05)
+    assert abs(flow[25, 11, 0]) < 0.05 and np.abs(flow[owned][:, 1]).max() < 1e-3
+
+
+def test_strokes_hidden_layers_and_other_elements_are_named_or_left_out(tmp_path):
+    document = _write(tmp_path, '<g id="a"><circle cx="20" cy="20" r="8" stroke="red"/><text>hi</text></g>'
+                                '<g id="b"><rect width="10" height="10" fill="none"/></g>')
+    found, unread = outlines(document.static_tree(["a"], 0.0), SIZE)
+    assert [outline.key for outline in found] == [(0, 0)]
+    assert unread == ["<circle> at (0, 0) (its stroke)", "<text> at (0, 1)"]
+    found, unread = outlines(document.static_tree(["b"], 0.0), SIZE)
+    assert found == [] and unread == []
