@@ -311,7 +311,9 @@ def compute_guides(
         Directory for the memory-mapped cache (about 24 bytes per pixel and frame).
     given_flow : callable or sequence, optional
         Flow of frame ``j`` as an (H, W, 2) float32 array (dx, dy) px/frame or a
-        ``.npy``/``.flo`` path; used as is in place of the estimate from the masks.
+        ``.npy``/``.flo`` path; used as is in place of the estimate from the masks, except
+        where it is NaN (nothing known there, e.g. what the vector geometry does not
+        describe): there the estimate fills in.
     progress : callable, optional
         ``progress(done, total)`` after each frame of each pass; ``total = 2·T``.
 
@@ -373,6 +375,9 @@ def compute_guides(
             frame_flow = raw_flows.smoothed(index, flow_taps)
         else:
             frame_flow = _given_flow(get_flow(index), index, shape)
+            unknown = ~np.isfinite(frame_flow).all(axis=2)
+            if unknown.any():
+                frame_flow[unknown] = raw_flows.smoothed(index, flow_taps)[unknown]
         frame_dist = dists.get(index)
         mask = frame_dist > 0
         ext_plus = extent.accumulate_extent(accumulator, frame_flow if index > 0 else zero_flow, mask)
