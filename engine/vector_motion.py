@@ -140,25 +140,25 @@ def affine_fit(element: MovingElement) -> np.ndarray:
 
 
 def element_flow(element: MovingElement, covered: np.ndarray, *, sweeps: int = 8) -> np.ndarray:
-    """(H, W, 2) float32: the element's motion at every pixel (meaningful where ``covered``).
+    """(H, W, 2) float32: the element's motion where ``covered`` (0 elsewhere).
 
-    The affine fit everywhere, plus, where the outline deforms beyond it, the harmonic fill
-    of the residual displacements from the outline points into ``covered``.
+    The affine fit, plus, where the outline deforms beyond it, the harmonic fill of the
+    residual displacements from the outline points into ``covered``.
     """
     height, width = covered.shape
     matrix = affine_fit(element)
-    yy, xx = np.mgrid[:height, :width].astype(np.float64) + 0.5
-    flow = np.stack([
-        matrix[0, 0] * xx + matrix[0, 1] * yy + matrix[0, 2],
-        matrix[1, 0] * xx + matrix[1, 1] * yy + matrix[1, 2],
-    ], axis=2)
+    rows, columns = np.nonzero(covered)
+    xx, yy = columns + 0.5, rows + 0.5
+    flow = np.zeros((height, width, 2), np.float32)
+    flow[rows, columns, 0] = matrix[0, 0] * xx + matrix[0, 1] * yy + matrix[0, 2]
+    flow[rows, columns, 1] = matrix[1, 0] * xx + matrix[1, 1] * yy + matrix[1, 2]
     now = element.now.astype(np.float64)
     residual = (now - element.before) - (np.column_stack([now, np.ones(now.shape[0])]) @ matrix.T)
     if np.abs(residual).max(initial=0.0) > 1e-3:
         values, fixed = _splat_outline(now, residual, (height, width))
         domain = covered | fixed
-        flow += harmonic_fill(values, fixed, domain, sweeps=sweeps)
-    return flow.astype(np.float32)
+        flow[covered] += harmonic_fill(values, fixed, domain, sweeps=sweeps)[covered]
+    return flow
 
 
 def _splat_outline(points: np.ndarray, residual: np.ndarray, shape: tuple[int, int]):

@@ -1,8 +1,9 @@
 """The per-layer stages of a render: masks, guides, stylize, colorize (see :mod:`fluidymation.pipeline.stage`).
 
 * ``masks`` rasterizes the layer's vector layers: binary masks, soft coverage and the
-  layer's summary record (fill colour, z-order, areas) in its manifest. Its key holds the
-  input files' content, the reader and the renderer.
+  layer's summary record (fill colour, z-order, areas) in its manifest; with ``flow:
+  vector`` also each frame's motion read from the geometry (``motion/``, NaN where
+  unknown). Its key holds the input files' content, the reader and the renderer.
 * ``guides`` writes views of the target guides (only with ``render --until guides``:
   stylize computes the guides itself, so it *repeats* this stage).
 * ``stylize`` runs the layer's stylizer (a plugin, :mod:`fluidymation.pipeline.stylizers`)
@@ -27,7 +28,7 @@ from fluidymation.pipeline.progress import progress, reporter
 from fluidymation.pipeline.resolve import Plan, PlannedLayer
 from fluidymation.pipeline.resume import FrameStates
 from fluidymation.pipeline.stage import LAYER, Done, Stage
-from fluidymation.stages import colorize, guides, rasterize
+from fluidymation.stages import colorize, guides, motion, rasterize
 from fluidymation.stages.colour import parse_hex
 from fluidymation.stages.exemplar_store import StoredSource
 from fluidymation.stages.files import read_image, write_npy, write_png
@@ -50,11 +51,13 @@ class MaskSettings:
     start: int
     end: int
     raster: rasterize.Params
+    flow: str
 
 
 def _mask_settings(work) -> MaskSettings:
     plan = work.plan
-    return MaskSettings(work.layer.vector_layers, plan.start, plan.end, rasterize.Params(size=plan.size, fps=plan.fps))
+    return MaskSettings(work.layer.vector_layers, plan.start, plan.end, rasterize.Params(size=plan.size, fps=plan.fps),
+                        work.layer.flow)
 
 
 def _mask_inputs(work) -> dict:
@@ -70,7 +73,46 @@ def _run_masks(work, key: str) -> Done:
                                  coverage_dir=out / "coverage" / layer.dirname, bar=bar)
     files = [out / folder / layer.dirname / f"{k:05d}.png" for folder in ("masks", "coverage")
              for k in range(plan.frame_count)]
+    if layer.flow == "vector":
+        with progress(plan.frame_count, "motion", layer=layer.name, quiet=work.quiet) as bar:
+            files += write_layer_motion(plan, layer, out / "motion" / layer.dirname, bar=bar)
     return Done(files, manifest={"record": record})
+
+
+def write_layer_motion(plan: Plan, layer: PlannedLayer, motion_dir: Path, *, bar=None) -> list[Path]:
+    """Each scene frame's motion read from the layer's geometry (:mod:`fluidymation.stages.motion`) as .npy.
+
+    What the geometry does not describe is NaN (the guides take the masks' estimate there);
+    the elements left to the masks are named in one warning.
+    """
+    unread: dict[str, None] = {}
+    files = []
+    for frame in range(plan.start, plan.end):
+        if plan.frame_count == 1:
+            flow = np.zeros((plan.size[1], plan.size[0], 2), np.float32)  # no second frame, no motion
+        else:
+            flow, missed = motion.frame_motion(plan.document, layer.vector_layers, frame, plan.fps, plan.size,
+                                               first=frame == plan.start)
+            unread.update(dict.fromkeys(missed))
+        files.append(motion_dir / f"{frame - plan.start:05d}.npy")
+        write_npy(files[-1], flow)
+        if bar is not None:
+            bar.update()
+    if unread:
+        names = list(unread)
+        log.warning("layer '%s': flow: vector does not read %s%s; the masks' motion estimate is used there",
+                    layer.name, ", ".join(names[:5]), f" and {len(names) - 5} more" if len(names) > 5 else "")
+    return files
+
+
+def layer_motion(out: Path, layer: PlannedLayer):
+    """The masks stage's motion of ``layer`` as ``given_flow(j)`` for the guides, or None with ``flow: masks``."""
+    return motion_reader(out / "motion" / layer.dirname) if layer.flow == "vector" else None
+
+
+def motion_reader(folder: Path):
+    """``given_flow(j)`` reading the motion files :func:`write_layer_motion` wrote to ``folder``."""
+    return lambda j: np.load(folder / f"{j:05d}.npy")
 
 
 def input_digest(plan: Plan) -> list[str]:
@@ -126,7 +168,7 @@ def _run_guides(work, key: str) -> Done:
     plan, layer = work.plan, work.layer
     out_dir = work.out / "guides" / layer.dirname
     write_layer_guides(plan, layer, work.window, lambda j: read_coverage(work.out / "coverage" / layer.dirname, j),
-                       out_dir, quiet=work.quiet)
+                       out_dir, quiet=work.quiet, given_flow=layer_motion(work.out, layer))
     return Done([out_dir / view / f"{frame - plan.start:05d}.png" for view in VIEWS for frame in work.window])
 
 
@@ -176,7 +218,7 @@ def _run_stylize(work, key: str) -> Done:
                   layer.name, order[resume[0] - 1], resume[0], len(order))
     files = stylize_layer(plan, layer, work.window, work.source, stylizer, work.stylize_params, work.guide_params,
                           coverage_dir=work.out / "coverage" / layer.dirname, out_dir=out_dir, quiet=work.quiet,
-                          nnf=options.nnf, states=states, resume=resume)
+                          nnf=options.nnf, states=states, resume=resume, given_flow=layer_motion(work.out, layer))
     return Done(files, report={"resumed": 0 if resume is None else resume[0]})
 
 
@@ -187,8 +229,10 @@ def stylized_files(out_dir: Path, index: int, *, nnf=False) -> list[Path]:
 
 def stylize_layer(plan: Plan, layer: PlannedLayer, window: range, source: StoredSource, stylizer: Stylizer, params,
                   guide_params: guides.Params, *, coverage_dir: Path, out_dir: Path, quiet=False, nnf=False,
-                  states: FrameStates | None = None, resume: tuple[int, Any] | None = None) -> list[Path]:
-    """Stylize a layer's window of scene frames (coverage read from ``coverage_dir``) into ``out_dir``.
+                  states: FrameStates | None = None, resume: tuple[int, Any] | None = None,
+                  given_flow=None) -> list[Path]:
+    """Stylize a layer's window of scene frames (coverage read from ``coverage_dir``) into ``out_dir``
+    (``given_flow``: the layer's motion from its geometry, :func:`layer_motion`).
 
     Returns the window's files. With ``states``, each frame's state is saved after its
     files; ``resume`` (from :meth:`FrameStates.resume_point`) continues after the frames
@@ -201,7 +245,7 @@ def stylize_layer(plan: Plan, layer: PlannedLayer, window: range, source: Stored
         bar.update(finished)
         job = StylizeJob(masks=lambda j: read_coverage(coverage_dir, j), frame_count=plan.frame_count,
                          frames=(window.start - plan.start, window.stop - plan.start), source=source,
-                         guide_params=guide_params, cache_dir=cache_dir, resume=after)
+                         guide_params=guide_params, cache_dir=cache_dir, resume=after, given_flow=given_flow)
         for result in stylizer.stylize(job, params):
             png, *nnf_file = stylized_files(out_dir, result.index, nnf=nnf)
             write_png(png, result.rgba)

@@ -29,8 +29,10 @@ _LAYER_NAME = re.compile(r"^[A-Za-z0-9_][A-Za-z0-9_.\- ]*$")
 
 _TOP_KEYS = ("version", "input", "animation", "theme", "fps", "frames", "size", "scale", "seed", "split", "output",
              "background", "exemplars", "defaults", "layers")
-_LAYER_KEYS = ("name", "select", "color", "exemplar", "stylizer", "colorize", "blend", "opacity", "params")
-_DEFAULT_KEYS = ("exemplar", "stylizer", "colorize", "blend", "opacity", "params")
+_LAYER_KEYS = ("name", "select", "color", "exemplar", "stylizer", "colorize", "blend", "opacity", "flow", "params")
+_DEFAULT_KEYS = ("exemplar", "stylizer", "colorize", "blend", "opacity", "flow", "params")
+#: Where a layer's motion comes from: the vector geometry, or the masks (paper appendix A).
+FLOW_SOURCES = ("vector", "masks")
 _EXEMPLAR_KEYS = ("builtin", "video", "images", "mask", "flow", "scale", "step", "frames", "reverse",
                   "seed", "size", "color", "wetness")
 
@@ -70,6 +72,9 @@ class LayerSpec:
     params: dict = field(default_factory=dict)
     #: Where in the scene file each of ``params`` was given (its key path), for error messages.
     param_paths: dict = field(default_factory=dict, compare=False)
+    #: ``vector``, ``masks`` or None (the geometry wherever the input's kind is read; docs/guides.md).
+    flow: str | None = None
+    flow_path: tuple = field(default=(), compare=False)
 
 
 @dataclass(frozen=True)
@@ -271,6 +276,8 @@ def _layer(check: Checker, where, allowed, exemplars: dict, base: LayerSpec | No
         opacity=check.number(where + ("opacity",), base.opacity if base else 1.0, minimum=0, maximum=1),
         params=(dict(base.params) if base else {}) | params,
         param_paths=(dict(base.param_paths) if base else {}) | {key: where + ("params", key) for key in params},
+        flow=check.text(where + ("flow",), base.flow if base else None, choices=FLOW_SOURCES),
+        flow_path=where + ("flow",) if check.has(where + ("flow",)) else base.flow_path if base else (),
     )
 
 

@@ -42,7 +42,7 @@ class FluidymationStylizer(Stylizer):
     def stylize(self, job: StylizeJob, params: stylize.Params):
         return stylize.stylize_sequence(job.masks, job.frame_count, job.source, params=params,
                                         guide_params=job.guide_params, cache_dir=job.cache_dir, frames=job.frames,
-                                        resume=job.resume)
+                                        resume=job.resume, given_flow=job.given_flow)
 
     def frame_state(self, frame: stylize.StylizedFrame) -> dict[str, np.ndarray]:
         return {"frame": frame.nnf.frame, "coords": frame.nnf.coords, "backlog": frame.backlog,

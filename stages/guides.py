@@ -28,6 +28,7 @@ from pathlib import Path
 from typing import Any, Callable, NamedTuple, Sequence, Union
 
 import numpy as np
+from scipy import ndimage
 
 from fluidymation.engine import distance, extent, flow as flow_kernels
 from fluidymation.errors import ParameterError, StageError
@@ -288,6 +289,31 @@ def _given_flow(item: Any, index: int, shape: tuple[int, int]) -> np.ndarray:
     return np.array(flow, dtype=np.float32, order="C", copy=True)
 
 
+def _fill_unknown(flow: np.ndarray, inside: np.ndarray, reach: float, estimate: Callable[[], np.ndarray]) -> np.ndarray:
+    """``flow`` with its NaN pixels filled. Up to ``reach`` px from known pixels (where a
+    geometry's coverage and the guides' blurred mask disagree: a rim, the gaps between a
+    gear's teeth) by the nearest known value. Further away by the masks' ``estimate()``
+    when some of those pixels lie inside the mask (so a layer the geometry says nothing
+    about gets exactly the estimate), else by 0 (outside the mask the flow is not used)."""
+    unknown = ~np.isfinite(flow).all(axis=2)
+    if not unknown.any():
+        return flow
+    far = unknown.copy()
+    known = ~unknown
+    if known.any():
+        rows, columns = np.nonzero(inside | known)
+        margin = int(np.ceil(reach)) + 1
+        window = (slice(max(rows.min() - margin, 0), rows.max() + margin + 1),
+                  slice(max(columns.min() - margin, 0), columns.max() + margin + 1))
+        distance, (near_rows, near_columns) = ndimage.distance_transform_edt(unknown[window], return_indices=True)
+        near = unknown[window] & (distance <= reach)
+        local = flow[window]
+        local[near] = local[near_rows[near], near_columns[near]]
+        far[window] &= ~near
+    flow[far] = estimate()[far] if (far & inside).any() else 0.0
+    return flow
+
+
 def compute_guides(
     masks: MaskSource,
     frame_count: int,
@@ -313,7 +339,9 @@ def compute_guides(
         Flow of frame ``j`` as an (H, W, 2) float32 array (dx, dy) px/frame or a
         ``.npy``/``.flo`` path; used as is in place of the estimate from the masks, except
         where it is NaN (nothing known there, e.g. what the vector geometry does not
-        describe): there the estimate fills in.
+        describe): within ``blur_sigma`` (at least 2 px) of known pixels the nearest known
+        value fills in, further away the estimate (0 when none of those pixels is inside
+        the mask).
     progress : callable, optional
         ``progress(done, total)`` after each frame of each pass; ``total = 2·T``.
 
@@ -374,10 +402,8 @@ def compute_guides(
         if get_flow is None:
             frame_flow = raw_flows.smoothed(index, flow_taps)
         else:
-            frame_flow = _given_flow(get_flow(index), index, shape)
-            unknown = ~np.isfinite(frame_flow).all(axis=2)
-            if unknown.any():
-                frame_flow[unknown] = raw_flows.smoothed(index, flow_taps)[unknown]
+            frame_flow = _fill_unknown(_given_flow(get_flow(index), index, shape), dists.get(index) > 0,
+                                       max(2.0, params.blur_sigma * scale), lambda: raw_flows.smoothed(index, flow_taps))
         frame_dist = dists.get(index)
         mask = frame_dist > 0
         ext_plus = extent.accumulate_extent(accumulator, frame_flow if index > 0 else zero_flow, mask)

@@ -227,6 +227,7 @@ def stylize_sequence(
     cache_dir,
     frames: tuple[int, int] | None = None,
     resume: tuple[int, NNF, np.ndarray] | None = None,
+    given_flow: Callable[[int], np.ndarray] | None = None,
 ) -> Iterator[StylizedFrame]:
     """Stylize a layer's mask sequence; yield each frame as soon as it is done.
 
@@ -252,6 +253,10 @@ def stylize_sequence(
         Continue after the already processed frame ``index`` (one of ``frames``) from its
         :class:`StylizedFrame` ``nnf``, ``backlog`` and colour ``rgba[..., :3]``; the frames yielded are then exactly
         those an uninterrupted run yields after ``index``.
+    given_flow : callable, optional
+        ``given_flow(j)``: frame j's motion (H, W, 2), NaN where unknown (the masks' estimate
+        fills in; :func:`~fluidymation.stages.guides.compute_guides`). Not used with
+        ``params.reverse`` (the motion of a reversed sequence is the masks' estimate).
 
     Yields
     ------
@@ -263,7 +268,9 @@ def stylize_sequence(
     if not 0 <= first < stop <= frame_count:
         raise StageError(f"stylize: frames {first}:{stop} outside 0:{frame_count}")
     order = list(range(frame_count - 1, -1, -1)) if params.reverse else list(range(frame_count))
-    target = guides.compute_guides(lambda k: masks(order[k]), frame_count, params=guide_params, cache_dir=cache_dir)
+    flow = None if given_flow is None or params.reverse else given_flow
+    target = guides.compute_guides(lambda k: masks(order[k]), frame_count, params=guide_params, cache_dir=cache_dir,
+                                   given_flow=flow)
     steps = [k for k in range(frame_count) if first <= order[k] < stop]
     previous = None
     if resume is not None:

@@ -60,7 +60,9 @@ class StylizeJob:
     ``0..frame_count−1``; ``frames`` = (first, stop) are the frames to yield; ``source``
     is the layer's exemplar with its guides, made with ``guide_params``; ``cache_dir`` is
     a scratch folder for the length of the job; ``resume`` is None or what
-    :meth:`Stylizer.resume_from` made of the state of the last finished frame.
+    :meth:`Stylizer.resume_from` made of the state of the last finished frame;
+    ``given_flow(j)``, when set, is frame j's motion read from the vector geometry (NaN where
+    unknown; docs/guides.md), for the guides in place of the masks' estimate.
     """
 
     masks: Callable[[int], np.ndarray]
@@ -70,6 +72,7 @@ class StylizeJob:
     guide_params: guides.Params
     cache_dir: str
     resume: Any = None
+    given_flow: Callable[[int], np.ndarray] | None = None
 
 
 class Stylizer(ABC):

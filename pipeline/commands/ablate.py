@@ -14,7 +14,7 @@ import dataclasses
 import numpy as np
 
 from fluidymation.errors import InputError
-from fluidymation.pipeline.layer_stages import stylize_layer
+from fluidymation.pipeline.layer_stages import layer_motion, stylize_layer
 from fluidymation.pipeline.parameters import layer_guide_params, layer_stylize_params, layer_stylizer
 from fluidymation.pipeline.progress import progress
 from fluidymation.pipeline.render import Options, load_layer_source, render, scaled_plan
@@ -63,7 +63,8 @@ def run(args) -> int:
         params = dataclasses.replace(full, **{name: 0.0 for name in switched_off})
         folder = out / "ablate" / layer.dirname / label.replace(" ", "-").replace("+", "-")
         stylize_layer(plan, layer, frames, source, stylizer, params, guide_params,
-                      coverage_dir=out / "coverage" / layer.dirname, out_dir=folder, quiet=args.quiet)
+                      coverage_dir=out / "coverage" / layer.dirname, out_dir=folder, quiet=args.quiet,
+                      given_flow=layer_motion(out, layer))
         panels.append((label, folder))
     video = out / "ablate" / f"{layer.dirname}.mp4"
     labels = label_strip([label for label, _ in panels], width=plan.size[0])

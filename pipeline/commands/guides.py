@@ -2,10 +2,11 @@
 
 from __future__ import annotations
 
+import tempfile
 from pathlib import Path
 
 from fluidymation.errors import InputError
-from fluidymation.pipeline.layer_stages import write_layer_guides
+from fluidymation.pipeline.layer_stages import motion_reader, write_layer_guides, write_layer_motion
 from fluidymation.pipeline.resolve import parse_window, plan_scene
 from fluidymation.pipeline.scene import load_scene
 from fluidymation.stages.rasterize import Params as RasterParams
@@ -42,7 +43,11 @@ def run(args) -> int:
         image = rasterize_frame(plan.renderer, plan.document, layer.vector_layers, plan.start + index, raster)
         return image.coverage
 
-    write_layer_guides(plan, layer, window, coverage, out_dir, quiet=args.quiet, raw=args.raw, given_flow=given)
+    with tempfile.TemporaryDirectory(prefix="fluidymation-motion-") as motion:
+        if given is None and layer.flow == "vector":
+            write_layer_motion(plan, layer, Path(motion))
+            given = motion_reader(Path(motion))
+        write_layer_guides(plan, layer, window, coverage, out_dir, quiet=args.quiet, raw=args.raw, given_flow=given)
     if not args.quiet:
         print(f"wrote guide views of frames {window.start}:{window.stop} of layer {layer.name} to {out_dir}")
     return 0

@@ -190,7 +190,22 @@ class SvgFrame(NamedTuple):
     source: str
 
 
-class SvgDocument(VectorDocument):
+class _StaticTrees(VectorDocument):
+    """An SVG kind whose frames are static trees (``static_tree``): its geometry is read for motion."""
+
+    reads_geometry = True
+
+    @abstractmethod
+    def static_tree(self, names, time_seconds) -> ElementTree.Element:
+        """The layers ``names`` as shown at ``time_seconds``, a static tree (animations applied)."""
+
+    def moving_elements(self, names, before_seconds, now_seconds, size):
+        from fluidymation.stages.vector.svg_geometry import moving_elements  # it reads this module's helpers
+
+        return moving_elements(self.static_tree(names, before_seconds), self.static_tree(names, now_seconds), size)
+
+
+class SvgDocument(_StaticTrees):
     """An SVG file: the same picture at every time, unless it holds :data:`ANIMATIONS`."""
 
     kind = "svg"
@@ -220,7 +235,7 @@ class SvgDocument(VectorDocument):
         return _hide_other_layers(_at_time(self.root, self.animations, time_seconds), names)
 
 
-class SvgSequenceDocument(VectorDocument):
+class SvgSequenceDocument(_StaticTrees):
     """Numbered SVG files, one per frame at ``fps``; layers (and what is not drawn) are those of the first file."""
 
     kind = "svg-sequence"

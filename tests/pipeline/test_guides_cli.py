@@ -53,3 +53,46 @@ def test_given_flows_replace_the_estimate(cli, tmp_path):
     assert np.array_equal(np.load(tmp_path / "g" / "flow" / "00002.npy"), np.full((48, 64, 2), (0.5, -1.5), np.float32))
     code, _, err = cli("guides", scene, "--layer", "disk", "--flow", tmp_path / "none" / "%03d.npy")
     assert code == 2 and "no files match" in err
+
+
+def turning_gear_scene(tmp_path, flow=None):
+    teeth = []
+    for k in range(32):
+        radius = 22 if k % 4 in (1, 2) else 15
+        angle = np.pi * k / 16
+        teeth.append(f"{32 + radius * np.cos(angle):.3f},{32 + radius * np.sin(angle):.3f}")
+    (tmp_path / "gear.svg").write_text(
+        '<svg xmlns="http://www.w3.org/2000/svg" width="64" height="64"><g id="gear">'
+        f'<path d="M{" L".join(teeth)} Z"/><animateTransform attributeName="transform" type="rotate" '
+        'from="0 32 32" to="360 32 32" dur="3s" repeatCount="indefinite"/></g></svg>')
+    chosen = "" if flow is None else f"    flow: {flow}\n"
+    return scene_for(tmp_path, "gear.svg", "frames: {start: 0, end: 4}\nlayers:\n  - name: gear\n" + chosen)
+
+
+def test_a_turning_gear_reads_its_motion_from_the_geometry_where_the_masks_see_almost_none(cli, tmp_path):
+    omega = np.radians(360 / 72)  # rad/frame at 24 fps
+    yy, xx = np.mgrid[:64, :64] + 0.5
+    radius = np.hypot(xx - 32, yy - 32)
+    hub = (radius > 3) & (radius < 14)  # inside the gear at every angle
+    speeds = {}
+    for flow in ("vector", "masks"):
+        folder = tmp_path / flow
+        folder.mkdir()
+        scene = turning_gear_scene(folder, None if flow == "vector" else flow)
+        code, _, err = cli("-q", "guides", scene, "--layer", "gear", "--raw", "-o", folder / "g")
+        assert code == 0, err
+        field = np.load(folder / "g" / "flow" / "00002.npy")
+        speeds[flow] = np.hypot(field[..., 0], field[..., 1])[hub] / (omega * radius[hub])
+    np.testing.assert_allclose(speeds["vector"], 1.0, rtol=0.05)  # flow: vector is the default for SVG
+    assert np.median(speeds["masks"]) < 0.5
+
+
+def test_flow_vector_is_refused_where_the_geometry_is_not_read(cli, tmp_path):
+    from tests.pipeline.test_masks_cli import EXAMPLES
+
+    scene = scene_for(tmp_path, EXAMPLES / "wave" / "wave.json", "defaults: {flow: vector}\n")
+    code, _, err = cli("masks", scene)
+    assert code == 2 and "flow: vector" in err and "lottie" in err and "Traceback" not in err
+    scene = scene_for(tmp_path, EXAMPLES / "wave" / "wave.json", "defaults: {flow: sideways}\n")
+    code, _, err = cli("masks", scene)
+    assert code == 2 and "'sideways' is not one of vector, masks" in err

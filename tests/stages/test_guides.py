@@ -142,16 +142,21 @@ def test_given_flows_from_npy_and_flo_files_replace_the_estimate(tmp_path):
         np.testing.assert_allclose(cache.frame(j).ext_minus, 4 - j, atol=1e-5)
 
 
-def test_the_estimate_fills_in_where_a_given_flow_is_nan(tmp_path):
+def test_unknown_parts_of_a_given_flow_take_the_nearest_known_value_or_the_estimate(tmp_path):
     masks = [disk(50, 40, 10 + 2 * j) for j in range(4)]
     estimated = guides.compute_guides(masks, 4, params=PARAMS, cache_dir=tmp_path / "estimated")
     partial = np.full((HEIGHT, WIDTH, 2), np.nan, np.float32)
-    partial[:, : WIDTH // 2] = (0.5, 0.25)  # known on the left half only
+    half = WIDTH // 2
+    partial[:, :half] = (0.5, 0.25)  # known on the left half only
     cache = guides.compute_guides(masks, 4, params=PARAMS, cache_dir=tmp_path / "given", given_flow=[partial] * 4)
+    unknown = guides.compute_guides(masks, 4, params=PARAMS, cache_dir=tmp_path / "unknown",
+                                    given_flow=[np.full_like(partial, np.nan)] * 4)
+    reach = max(2, int(PARAMS.blur_sigma))
     for j in range(4):
         flow = cache.frame(j).flow
-        np.testing.assert_array_equal(flow[:, : WIDTH // 2], partial[:, : WIDTH // 2])
-        np.testing.assert_array_equal(flow[:, WIDTH // 2:], estimated.frame(j).flow[:, WIDTH // 2:])
+        np.testing.assert_array_equal(flow[:, :half + reach], np.broadcast_to((0.5, 0.25), (HEIGHT, half + reach, 2)))
+        np.testing.assert_array_equal(flow[:, half + reach + 1:], estimated.frame(j).flow[:, half + reach + 1:])
+        np.testing.assert_array_equal(unknown.frame(j).flow, estimated.frame(j).flow)  # nothing known: the estimate
 
 
 def test_flo_round_trip_and_bad_files(tmp_path):
