@@ -54,6 +54,8 @@ class MovingElement:
         starts = np.ascontiguousarray(self.ring_starts, np.int64)
         if now.ndim != 2 or now.shape[1] != 2 or before.shape != now.shape:
             raise ValueError(f"now and before must both be (N, 2), got {now.shape} and {before.shape}")
+        if not (np.isfinite(now).all() and np.isfinite(before).all()):
+            raise ValueError("outline points must be finite")
         if starts.ndim != 1 or starts.size < 2 or starts[0] != 0 or starts[-1] != now.shape[0] or np.any(
                 np.diff(starts) < 0):
             raise ValueError("ring_starts must rise from 0 to the number of points")
@@ -94,8 +96,11 @@ def _coverage(points, ring_starts, even_odd, out):
             inside = (winding % 2 != 0) if even_odd else winding != 0
             if not inside:
                 continue
-            start = max(int(np.ceil(crossings[order[k]] - 0.5)), 0)
-            stop = min(int(np.ceil(crossings[order[k + 1]] - 0.5)), width)
+            # clamped before the conversion: a far-away outline must not overflow the integers
+            start = int(np.ceil(min(max(crossings[order[k]], -1.0), width + 1.0) - 0.5))
+            stop = int(np.ceil(min(max(crossings[order[k + 1]], -1.0), width + 1.0) - 0.5))
+            start = max(start, 0)
+            stop = min(stop, width)
             for column in range(start, stop):
                 out[row, column] = True
 

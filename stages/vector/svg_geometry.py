@@ -34,6 +34,8 @@ from fluidymation.stages.vector.svg_reader import style_property, svg_size
 _SHAPES = {"path", "rect", "circle", "ellipse", "polygon", "polyline"}
 _CONTAINERS = {"g", "a", "switch"}
 _NO_BOX = Box(0.0, 0.0, 0.0, 0.0)
+#: Outline coordinates (output px) beyond this are left to the masks (float32 keeps them within 1 px).
+_FARTHEST = 1e7
 _NOT_DRAWN = {"defs", "title", "desc", "metadata", "style", "script", "clipPath", "mask", "linearGradient",
               "radialGradient", "pattern", "marker", "symbol", "filter", "animate", "animateTransform",
               "animateMotion", "set", "mpath"}
@@ -86,18 +88,20 @@ def _viewport(root: ElementTree.Element, out_size: tuple[int, int]) -> Matrix:
     """User space of the root → output pixels: the viewBox fitted as ``preserveAspectRatio`` says, then scaled."""
     width, height = svg_size(root, "svg")
     to_output = (out_size[0] / width, 0.0, 0.0, out_size[1] / height, 0.0, 0.0)
-    box = (root.get("viewBox") or "").replace(",", " ").split()
-    if len(box) != 4:
+    try:
+        x, y, box_width, box_height = (float(value) for value in (root.get("viewBox") or "").replace(",", " ").split())
+    except ValueError:  # none, or not four numbers: no viewBox, as the renderer takes it
         return to_output
-    x, y, box_width, box_height = (float(value) for value in box)
+    if not (box_width > 0 and box_height > 0):
+        return to_output
     scale_x, scale_y = width / box_width, height / box_height
-    align, *slice_ = (root.get("preserveAspectRatio") or "xMidYMid meet").split()
+    align, *slice_ = (root.get("preserveAspectRatio") or "xMidYMid meet").split() or ["xMidYMid"]
     if align == "none":
         return multiply(to_output, (scale_x, 0.0, 0.0, scale_y, -x * scale_x, -y * scale_y))
     scale = max(scale_x, scale_y) if slice_ == ["slice"] else min(scale_x, scale_y)
     fraction = {"Min": 0.0, "Mid": 0.5, "Max": 1.0}
-    shift_x = (width - box_width * scale) * fraction[align[1:4]]
-    shift_y = (height - box_height * scale) * fraction[align[5:8]]
+    shift_x = (width - box_width * scale) * fraction.get(align[1:4], 0.5)
+    shift_y = (height - box_height * scale) * fraction.get(align[5:8], 0.5)
     return multiply(to_output, (scale, 0.0, 0.0, scale, shift_x - x * scale, shift_y - y * scale))
 
 
@@ -155,16 +159,23 @@ def outlines(root: ElementTree.Element, out_size: tuple[int, int]) -> tuple[list
             return
         fill = _attribute(element, "fill") or fill
         fill_rule = _attribute(element, "fill-rule") or fill_rule
-        matrix = multiply(matrix, _transform(element))
         kind = local_name(element.tag)
+        try:
+            matrix = multiply(matrix, _transform(element))
+            if kind in _SHAPES:
+                data = _path_data(element) if fill != "none" else None
+        except ValueError as error:  # drawn as the renderer reads it; its motion is left to the masks
+            unread.append(f"<{kind}> at {key} ({error})")
+            return
         if kind in _SHAPES:
             stroke = _attribute(element, "stroke")
             if stroke not in (None, "none"):
                 unread.append(f"<{kind}> at {key} (its stroke)")
-            data = _path_data(element) if fill != "none" else None
-            rings = [] if data is None else subpath_rings(data)
-            if rings:
-                found.append(Outline(key, [_apply(matrix, ring) for ring in rings], fill_rule == "evenodd"))
+            rings = [] if data is None else [_apply(matrix, ring) for ring in subpath_rings(data)]
+            if rings and all(np.abs(ring).max() < _FARTHEST for ring in rings):  # NaN fails too
+                found.append(Outline(key, rings, fill_rule == "evenodd"))
+            elif rings:
+                unread.append(f"<{kind}> at {key} (coordinates out of range)")
             return
         if kind in _CONTAINERS:
             for index, child in enumerate(element):

@@ -96,3 +96,23 @@ def test_strokes_hidden_layers_and_other_elements_are_named_or_left_out(tmp_path
     assert unread == ["<circle> at (0, 0) (its stroke)", "<text> at (0, 1)"]
     found, unread = outlines(document.static_tree(["b"], 0.0), SIZE)
     assert found == [] and unread == []
+
+
+def test_elements_it_cannot_read_are_named_not_fatal(tmp_path):
+    document = _write(tmp_path, '<path d="M 1"/><rect width="5" height="5" transform="rotate(oops)"/>'
+                                '<circle cx="1e38" cy="0" r="1e38"/><ellipse cx="10" cy="10" rx="4" ry="3"/>')
+    found, unread = outlines(document.static_tree(document.layer_names(), 0.0), SIZE)
+    assert [outline.key for outline in found] == [(3,)]
+    assert len(unread) == 3 and unread[0].startswith("<path> at (0,) (") and "<rect> at (1,)" in unread[1]
+    assert unread[2] == "<circle> at (2,) (coordinates out of range)"
+
+
+@pytest.mark.parametrize("view, aspect", [("0 0 0 10", ""), ("a b c d", ""), ("0 0 32 32", ' preserveAspectRatio=""'),
+                                          ("0 0 32 32", ' preserveAspectRatio="bogus"')])
+def test_odd_viewports_do_not_stop_it(tmp_path, view, aspect):
+    path = tmp_path / "odd.svg"
+    path.write_text(f'<svg xmlns="http://www.w3.org/2000/svg" width="64" height="64" viewBox="{view}"{aspect}>'
+                    '<rect width="8" height="8"/></svg>')
+    document = open_document(path, fps=FPS)
+    found, _ = outlines(document.static_tree(document.layer_names(), 0.0), SIZE)
+    assert len(found) == 1
