@@ -20,13 +20,12 @@ from dataclasses import dataclass
 from xml.etree import ElementTree
 
 import numpy as np
-import tinycss2
-
 from fluidymation.engine.vector_motion import MovingElement
 from fluidymation.stages.vector.css_transform import (
     IDENTITY, Box, Matrix, matrix_of, multiply, origin_point, parse_origin, parse_svg_transform,
     resolve,
 )
+from fluidymation.stages.vector.css_syntax import tokens
 from fluidymation.stages.vector.safety import local_name
 from fluidymation.stages.vector.smil_path import PathData, subpath_rings
 from fluidymation.stages.vector.svg_reader import style_property, svg_size
@@ -70,18 +69,14 @@ def _transform(element: ElementTree.Element) -> Matrix:
     one: a matrix about ``transform-origin``) over the ``transform`` attribute."""
     css = style_property(element, "transform")
     if css is not None:
-        origin = origin_point(parse_origin(_values(style_property(element, "transform-origin") or "0 0")), _NO_BOX)
-        inner = matrix_of(resolve(parse_svg_transform(_values(css)), _NO_BOX))  # the reader writes a matrix()
+        origin = origin_point(parse_origin(tokens(style_property(element, "transform-origin") or "0 0")), _NO_BOX)
+        inner = matrix_of(resolve(parse_svg_transform(tokens(css)), _NO_BOX))  # the reader writes a matrix()
         return multiply(multiply((1.0, 0.0, 0.0, 1.0, *origin), inner), (1.0, 0.0, 0.0, 1.0, -origin[0], -origin[1]))
     text = element.get("transform")
     if not text:
         return IDENTITY
-    functions = parse_svg_transform(tinycss2.parse_component_value_list(text))
+    functions = parse_svg_transform(tokens(text))
     return matrix_of(resolve(functions, _NO_BOX))  # an SVG transform's lengths are user units, never percentages
-
-
-def _values(text: str) -> list:
-    return [value for value in tinycss2.parse_component_value_list(text) if value.type != "whitespace"]
 
 
 def _viewport(root: ElementTree.Element, out_size: tuple[int, int]) -> Matrix:
@@ -154,11 +149,12 @@ def outlines(root: ElementTree.Element, out_size: tuple[int, int]) -> tuple[list
     found: list[Outline] = []
     unread: list[str] = []
 
-    def visit(element, key, matrix, fill, fill_rule):
+    def visit(element, key, matrix, fill, fill_rule, stroke):
         if _attribute(element, "display") == "none":
             return
         fill = _attribute(element, "fill") or fill
         fill_rule = _attribute(element, "fill-rule") or fill_rule
+        stroke = _attribute(element, "stroke") or stroke
         kind = local_name(element.tag)
         try:
             matrix = multiply(matrix, _transform(element))
@@ -168,8 +164,7 @@ def outlines(root: ElementTree.Element, out_size: tuple[int, int]) -> tuple[list
             unread.append(f"<{kind}> at {key} ({error})")
             return
         if kind in _SHAPES:
-            stroke = _attribute(element, "stroke")
-            if stroke not in (None, "none"):
+            if stroke != "none":
                 unread.append(f"<{kind}> at {key} (its stroke)")
             rings = [] if data is None else [_apply(matrix, ring) for ring in subpath_rings(data)]
             if rings and all(np.abs(ring).max() < _FARTHEST for ring in rings):  # NaN fails too
@@ -179,14 +174,15 @@ def outlines(root: ElementTree.Element, out_size: tuple[int, int]) -> tuple[list
             return
         if kind in _CONTAINERS:
             for index, child in enumerate(element):
-                visit(child, key + (index,), matrix, fill, fill_rule)
+                visit(child, key + (index,), matrix, fill, fill_rule, stroke)
             return
         if kind not in _NOT_DRAWN and isinstance(element.tag, str):
             unread.append(f"<{kind}> at {key}")
 
     viewport = _viewport(root, out_size)
     for index, child in enumerate(root):
-        visit(child, (index,), viewport, _attribute(root, "fill") or "black", _attribute(root, "fill-rule") or "nonzero")
+        visit(child, (index,), viewport, _attribute(root, "fill") or "black", _attribute(root, "fill-rule") or "nonzero",
+              _attribute(root, "stroke") or "none")
     return found, unread
 
 

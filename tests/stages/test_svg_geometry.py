@@ -116,3 +116,10 @@ def test_odd_viewports_do_not_stop_it(tmp_path, view, aspect):
     document = open_document(path, fps=FPS)
     found, _ = outlines(document.static_tree(document.layer_names(), 0.0), SIZE)
     assert len(found) == 1
+
+
+def test_transform_lists_and_inherited_strokes(tmp_path):
+    document = _write(tmp_path, '<g transform="translate(10 0) scale(2)" stroke="red"><rect width="4" height="4"/></g>')
+    found, unread = outlines(document.static_tree(document.layer_names(), 0.0), SIZE)
+    np.testing.assert_allclose(found[0].rings[0][:4], [(10, 0), (18, 0), (18, 8), (10, 8)])
+    assert unread == ["<rect> at (0, 0) (its stroke)"]
