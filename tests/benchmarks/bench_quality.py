@@ -2,7 +2,7 @@
 
 Run: ``NUMBA_CACHE_DIR=.numba-cache .venv/bin/python tests/benchmarks/bench_quality.py
 [--scenes translation still ...] [--media watercolor-bloom ...] [--scale K] [--exemplar-size N]
-[--write-docs] [--record-baseline]``.
+[--true-motion] [--write-docs] [--record-baseline]``.
 
 Each scene is a layer of 12 frames drawn analytically here (soft 1-px edges) on a 128-px
 canvas, or K times larger with ``--scale``, stylized with the stylizer's defaults
@@ -15,6 +15,8 @@ command, the date and the load average to docs/quality.md and one contact sheet 
 to docs/quality/ (other sizes: docs/quality-<size>-<exemplar size>.md and its folder).
 ``--record-baseline`` stores this run's texture fidelity in docs/quality/baseline.json under
 its sizes: the "no worse than today" reference later runs of those sizes are checked against.
+``--true-motion`` gives the guides each scene's own motion in place of the masks' estimate,
+as ``flow: vector`` does for a vector input (printed only).
 """
 
 from __future__ import annotations
@@ -213,18 +215,20 @@ def load_exemplar(medium: str, size: int, workdir: Path, guide_params: guides.Pa
 
 
 def render(scene: Scene, exemplar: Exemplar, params: stylize.Params, guide_params: guides.Params,
-           cache_dir: Path) -> np.ndarray:
-    """The stylized layer, (T, H, W, 4)."""
+           cache_dir: Path, true_motion: bool = False) -> np.ndarray:
+    """The stylized layer, (T, H, W, 4); with ``true_motion`` its guides take the scene's own motion
+    (frame 0 that of frame 1)."""
+    given = (lambda j: scene.displacement(max(j, 1)).astype(np.float32)) if true_motion else None
     frames = stylize.stylize_sequence(scene.coverage, FRAMES, exemplar.source, params=params,
-                                      guide_params=guide_params, cache_dir=cache_dir)
+                                      guide_params=guide_params, cache_dir=cache_dir, given_flow=given)
     return np.stack([frame.rgba for frame in frames])
 
 
 def measure(scene: Scene, exemplar: Exemplar, params: stylize.Params, guide_params: guides.Params,
-            workdir: Path) -> tuple[dict, np.ndarray]:
+            workdir: Path, true_motion: bool = False) -> tuple[dict, np.ndarray]:
     """Render the scene (and its ``w_temp: 0`` twin when it has a still region); return its figures and frames."""
     masks = [scene.coverage(t) for t in range(FRAMES)]
-    output = render(scene, exemplar, params, guide_params, workdir / "default")
+    output = render(scene, exemplar, params, guide_params, workdir / "default", true_motion)
     still = [quality.still_region(masks[t - 1], masks[t], scene.displacement(t)) for t in range(1, FRAMES)]
     bands = [quality.moving_band(masks[t - 1], masks[t]) for t in range(1, FRAMES)]
     changes = [quality.change(a, b) for a, b in zip(output, output[1:])]
@@ -234,7 +238,8 @@ def measure(scene: Scene, exemplar: Exemplar, params: stylize.Params, guide_para
     still_change = quality.pooled_mean(changes, still, min_pixels=MIN_REGION)
     independent = float("nan")
     if np.isfinite(still_change):
-        without = render(scene, exemplar, dataclasses.replace(params, w_temp=0.0), guide_params, workdir / "w_temp0")
+        without = render(scene, exemplar, dataclasses.replace(params, w_temp=0.0), guide_params, workdir / "w_temp0",
+                         true_motion)
         independent = quality.pooled_mean([quality.change(a, b) for a, b in zip(without, without[1:])], still)
     figures = {
         "profile": peak, "profile_band": band, "profile_curve": profile_curve(profile, counts),
@@ -493,7 +498,11 @@ def main():
                         help="a stylizer parameter instead of its default (YAML value; repeatable)")
     parser.add_argument("--guide", action="append", default=[], metavar="NAME=VALUE",
                         help="a guides parameter instead of its default (YAML value; repeatable)")
+    parser.add_argument("--true-motion", action="store_true",
+                        help="guides from each scene's own motion instead of the masks' estimate (printed only)")
     args = parser.parse_args()
+    if args.true_motion and (args.write_docs or args.record_baseline):
+        raise SystemExit("--true-motion runs are printed only (no --write-docs, --record-baseline)")
     setup = Setup(Canvas(args.scale), args.exemplar_size)
     scenes = [s for s in make_scenes(setup.canvas) if s.name in args.scenes]
     command = "NUMBA_CACHE_DIR=.numba-cache .venv/bin/python " + shlex.join(["tests/benchmarks/bench_quality.py",
@@ -513,7 +522,8 @@ def main():
             results.append((medium, exemplar.figures, []))
             for scene in scenes:
                 begun = time.perf_counter()
-                figures, output = measure(scene, exemplar, params, guide_params, workdir / medium / scene.name)
+                figures, output = measure(scene, exemplar, params, guide_params, workdir / medium / scene.name,
+                                          args.true_motion)
                 results[-1][2].append((scene.name, figures))
                 sheet_rows[scene.name].append((exemplar.rgb, output))
                 print(f"{medium} / {scene.name}: {time.perf_counter() - begun:.1f} s", file=sys.stderr, flush=True)
