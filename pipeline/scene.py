@@ -248,6 +248,16 @@ def _exemplar_options(check: Checker, where) -> dict:
     return options
 
 
+def _param_value(check: Checker, path, value):
+    """A stylizer parameter as given: a number, true/false, text, or a list of numbers (per-level counts
+    such as ``opt_iters: [4, 2, 1]``, as a tuple); the stylizer's parameter types check it further."""
+    if isinstance(value, list) and all(isinstance(item, (int, float)) and not isinstance(item, bool) for item in value):
+        return tuple(value)
+    if not isinstance(value, (int, float, bool, str)):
+        raise check.error(path, "expected a number, true/false, text or a list of numbers")
+    return value
+
+
 def _layer(check: Checker, where, allowed, exemplars: dict, base: LayerSpec | None) -> LayerSpec:
     check.mapping(where, allowed, required=base is not None)
     name = check.text(where + ("name",)) if base is not None else ""
@@ -261,10 +271,8 @@ def _layer(check: Checker, where, allowed, exemplars: dict, base: LayerSpec | No
     colorize = check.text(where + ("colorize",), base.colorize if base else "layer")
     if colorize not in ("layer", "none"):
         colorize = check.color(where + ("colorize",))
-    params = check.mapping(where + ("params",), None)
-    for key, value in params.items():
-        if not isinstance(value, (int, float, bool, str)):
-            raise check.error(where + ("params", key), "expected a number, true/false or text")
+    params = {key: _param_value(check, where + ("params", key), value)
+              for key, value in check.mapping(where + ("params",), None).items()}
     return LayerSpec(
         name=name,
         select=tuple(check.text_list(where + ("select",), None) or ([name] if name else [])),

@@ -51,6 +51,14 @@ def test_a_count_or_a_text_of_counts_is_accepted(tmp_path):
     assert params.seed == 0 and params.w_bound == 4.0  # the scene's seed, configs/fluidymation.yaml's default
 
 
+def test_a_list_of_counts_is_accepted_and_a_list_of_anything_else_refused_at_its_key(tmp_path):
+    plan = _plan(tmp_path, "  - {name: blob, params: {opt_iters: [2, 1], pm_iters: [5, 2, 2]}}\n")
+    params = parameters.layer_stylize_params(plan, plan.layer("blob"))
+    assert params.opt_iters == (2, 1) and params.pm_iters == (5, 2, 2)
+    error = _error(lambda: _plan(tmp_path / "bad", "  - {name: blob, params: {opt_iters: [2, x]}}\n"))
+    assert "layers[0].params.opt_iters: expected a number, true/false, text or a list of numbers" in error
+
+
 def test_a_bad_defaults_file_is_reported_in_that_file(tmp_path, monkeypatch):
     stylizer = get_stylizer("fluidymation")
     config = tmp_path / "fluidymation.yaml"
