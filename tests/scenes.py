@@ -55,3 +55,22 @@ def spreading_wash(*, size: int, frames: int, seed: int, start_radius: float, gr
     density = np.clip(0.55 + 0.3 * texture / texture.std(), 0, 1) * mask
     rgb = (0.95 * (1 - density[..., None]) + np.array([0.2, 0.45, 0.85]) * density[..., None]).astype(np.float32)
     return rgb, mask
+
+
+def gear_path(centre: tuple[float, float], inner: float, outer: float, teeth: int = 8) -> str:
+    """SVG path data of a gear: ``teeth`` square teeth from radius ``inner`` to ``outer`` (4 vertices each)."""
+    points = []
+    for k in range(4 * teeth):
+        radius = outer if k % 4 in (1, 2) else inner
+        angle = 2 * np.pi * k / (4 * teeth)
+        points.append(f"{centre[0] + radius * np.cos(angle):.4f},{centre[1] + radius * np.sin(angle):.4f}")
+    return "M" + " L".join(points) + " Z"
+
+
+def turning_gear_svg(folder: Path) -> Path:
+    """``folder/gear.svg``: a 64-px gear (layer ``gear``) turned once every 3 s by SMIL ``animateTransform``."""
+    path = folder / "gear.svg"
+    path.write_text('<svg xmlns="http://www.w3.org/2000/svg" width="64" height="64"><g id="gear">'
+                    f'<path d="{gear_path((32, 32), 15, 22)}"/><animateTransform attributeName="transform" '
+                    'type="rotate" from="0 32 32" to="360 32 32" dur="3s" repeatCount="indefinite"/></g></svg>')
+    return path

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import sys
 import tempfile
 import time
 from pathlib import Path
@@ -29,20 +30,10 @@ from fluidymation.stages.rasterize import rasterize_frame
 from fluidymation.stages.vector import open_document, renderer_for
 
 ROOT = Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(ROOT))
+from tests.scenes import turning_gear_svg  # noqa: E402
+
 FPS = 24.0
-
-
-def gear_svg(folder: Path) -> Path:
-    teeth = []
-    for k in range(32):
-        radius = 22 if k % 4 in (1, 2) else 15
-        angle = np.pi * k / 16
-        teeth.append(f"{32 + radius * np.cos(angle):.3f},{32 + radius * np.sin(angle):.3f}")
-    path = folder / "gear.svg"
-    path.write_text('<svg xmlns="http://www.w3.org/2000/svg" width="64" height="64"><g id="gear">'
-                    f'<path d="M{" L".join(teeth)} Z"/><animateTransform attributeName="transform" type="rotate" '
-                    'from="0 32 32" to="360 32 32" dur="3s" repeatCount="indefinite"/></g></svg>')
-    return path
 
 
 def measure(path: Path, layer: str, size: int, frames: int, folder: Path) -> dict:
@@ -74,7 +65,7 @@ def main():
     with tempfile.TemporaryDirectory() as folder:
         folder = Path(folder)
         for name, path, layer in (("blob", ROOT / "examples" / "blob" / "blob.svg", "blob"),
-                                  ("gear", gear_svg(folder), "gear")):
+                                  ("gear", turning_gear_svg(folder), "gear")):
             times = measure(path, layer, args.size, args.frames, folder / name)
             ratio = (times["geometry"] + times["given"]) / times["estimated"]
             print(f"  {name:8s} {times['geometry']:9.3f} {times['estimated']:15.3f} {times['given']:16.3f} "

@@ -3,6 +3,7 @@
 import numpy as np
 
 from tests.pipeline.test_bad_input import scene_for
+from tests.scenes import turning_gear_svg
 
 
 def moving_disk_scene(tmp_path, frames=16):
@@ -56,15 +57,7 @@ def test_given_flows_replace_the_estimate(cli, tmp_path):
 
 
 def turning_gear_scene(tmp_path, flow=None):
-    teeth = []
-    for k in range(32):
-        radius = 22 if k % 4 in (1, 2) else 15
-        angle = np.pi * k / 16
-        teeth.append(f"{32 + radius * np.cos(angle):.3f},{32 + radius * np.sin(angle):.3f}")
-    (tmp_path / "gear.svg").write_text(
-        '<svg xmlns="http://www.w3.org/2000/svg" width="64" height="64"><g id="gear">'
-        f'<path d="M{" L".join(teeth)} Z"/><animateTransform attributeName="transform" type="rotate" '
-        'from="0 32 32" to="360 32 32" dur="3s" repeatCount="indefinite"/></g></svg>')
+    turning_gear_svg(tmp_path)
     chosen = "" if flow is None else f"    flow: {flow}\n"
     return scene_for(tmp_path, "gear.svg", "frames: {start: 0, end: 4}\nlayers:\n  - name: gear\n" + chosen)
 

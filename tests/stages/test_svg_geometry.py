@@ -7,6 +7,8 @@ from fluidymation.engine.vector_motion import vector_flow
 from fluidymation.stages.vector import open_document
 from fluidymation.stages.vector.svg_geometry import moving_elements, outlines
 
+from tests.scenes import gear_path
+
 FPS = 24.0
 SIZE = (64, 64)
 
@@ -25,15 +27,6 @@ def _flow(document, frame, size=SIZE):
     return flow, owned, unread
 
 
-def _gear(centre, inner, outer, teeth=8):
-    points = []
-    for k in range(4 * teeth):
-        radius = outer if k % 4 in (1, 2) else inner
-        angle = 2 * math.pi * k / (4 * teeth)
-        points.append(f"{centre[0] + radius * math.cos(angle):.4f},{centre[1] + radius * math.sin(angle):.4f}")
-    return "M" + " L".join(points) + " Z"
-
-
 def _assert_turning(flow, owned, centre, degrees_per_frame, clockwise=True):
     omega = math.radians(degrees_per_frame)
     yy, xx = np.nonzero(owned)
@@ -50,7 +43,7 @@ def _assert_turning(flow, owned, centre, degrees_per_frame, clockwise=True):
 
 @pytest.mark.parametrize("shape", ["disk", "gear"])
 def test_a_smil_rotation_reads_omega_r_along_the_tangent(tmp_path, shape):
-    drawn = ('<circle cx="32" cy="32" r="24"/>' if shape == "disk" else f'<path d="{_gear((32, 32), 18, 26)}"/>')
+    drawn = ('<circle cx="32" cy="32" r="24"/>' if shape == "disk" else f'<path d="{gear_path((32, 32), 18, 26)}"/>')
     document = _write(tmp_path, f'<g id="wheel">{drawn}<animateTransform attributeName="transform" type="rotate" '
                                 'from="0 32 32" to="360 32 32" dur="3s" repeatCount="indefinite"/></g>')
     flow, owned, unread = _flow(document, 5)
@@ -61,7 +54,7 @@ def test_a_smil_rotation_reads_omega_r_along_the_tangent(tmp_path, shape):
 def test_a_css_rotation_in_a_scaled_viewbox_reads_in_output_pixels(tmp_path):
     document = _write(tmp_path, '<style>#gear { transform-origin: 16px 16px; animation: spin 2s linear infinite } '
                                 '@keyframes spin { to { transform: rotate(-360deg) } }</style>'
-                                f'<path id="gear" d="{_gear((16, 16), 9, 13)}"/>', view="0 0 32 32")
+                                f'<path id="gear" d="{gear_path((16, 16), 9, 13)}"/>', view="0 0 32 32")
     flow, owned, unread = _flow(document, 3, size=(128, 128))
     assert unread == []
     _assert_turning(flow, owned, (64, 64), 360 / (2 * FPS), clockwise=False)
