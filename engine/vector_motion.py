@@ -124,6 +124,11 @@ def _point_weights(element: MovingElement) -> np.ndarray:
     return weights
 
 
+def _homogeneous(points: np.ndarray) -> np.ndarray:
+    """(N, 2) points as rows ``(x, y, 1)``."""
+    return np.column_stack([points, np.ones(points.shape[0])])
+
+
 def affine_fit(element: MovingElement) -> np.ndarray:
     """The affine motion ``d(p) = M @ (x, y, 1)`` best fitting the outline's displacements, M (2, 3).
 
@@ -135,7 +140,7 @@ def affine_fit(element: MovingElement) -> np.ndarray:
     weights = _point_weights(element)
     if weights.sum() <= 0.0:
         weights = np.ones_like(weights)
-    design = np.column_stack([now, np.ones(now.shape[0])]) * np.sqrt(weights)[:, None]
+    design = _homogeneous(now) * np.sqrt(weights)[:, None]
     target = moved * np.sqrt(weights)[:, None]
     if np.linalg.matrix_rank(design) < 3:
         mean = (moved * weights[:, None]).sum(axis=0) / weights.sum()
@@ -145,25 +150,20 @@ def affine_fit(element: MovingElement) -> np.ndarray:
 
 
 def element_flow(element: MovingElement, covered: np.ndarray, *, sweeps: int = 8) -> np.ndarray:
-    """(H, W, 2) float32: the element's motion where ``covered`` (0 elsewhere).
+    """(N, 2) float32: the element's motion at the ``covered`` pixels, in the order of ``np.nonzero(covered)``.
 
     The affine fit, plus, where the outline deforms beyond it, the harmonic fill of the
     residual displacements from the outline points into ``covered``.
     """
-    height, width = covered.shape
     matrix = affine_fit(element)
     rows, columns = np.nonzero(covered)
-    xx, yy = columns + 0.5, rows + 0.5
-    flow = np.zeros((height, width, 2), np.float32)
-    flow[rows, columns, 0] = matrix[0, 0] * xx + matrix[0, 1] * yy + matrix[0, 2]
-    flow[rows, columns, 1] = matrix[1, 0] * xx + matrix[1, 1] * yy + matrix[1, 2]
+    motion = _homogeneous(np.column_stack([columns + 0.5, rows + 0.5])) @ matrix.T
     now = element.now.astype(np.float64)
-    residual = (now - element.before) - (np.column_stack([now, np.ones(now.shape[0])]) @ matrix.T)
+    residual = (now - element.before) - _homogeneous(now) @ matrix.T
     if np.abs(residual).max(initial=0.0) > 1e-3:
-        values, fixed = _splat_outline(now, residual, (height, width))
-        domain = covered | fixed
-        flow[covered] += harmonic_fill(values, fixed, domain, sweeps=sweeps)[covered]
-    return flow
+        values, fixed = _splat_outline(now, residual, covered.shape)
+        motion += harmonic_fill(values, fixed, covered | fixed, sweeps=sweeps)[rows, columns]
+    return motion.astype(np.float32)
 
 
 def _splat_outline(points: np.ndarray, residual: np.ndarray, shape: tuple[int, int]):
@@ -193,6 +193,6 @@ def vector_flow(elements: list[MovingElement], shape: tuple[int, int]) -> tuple[
         covered = coverage(element, shape)
         if not covered.any():
             continue
-        flow[covered] = element_flow(element, covered)[covered]
+        flow[covered] = element_flow(element, covered)
         owned |= covered
     return flow, owned

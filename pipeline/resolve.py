@@ -14,6 +14,7 @@ from dataclasses import dataclass, replace
 from fluidymation.errors import InputError, SceneError
 from fluidymation.pipeline.scene import MAX_FRAMES, MAX_SIZE, LayerSpec, Scene
 from fluidymation.stages.vector import DEFAULT_FPS, Renderer, VectorDocument, open_document, renderer_for
+from fluidymation.stages.vector.base import GeometryDocument
 
 log = logging.getLogger(__name__)
 
@@ -160,8 +161,8 @@ def _layers(scene: Scene, document: VectorDocument) -> tuple[PlannedLayer, ...]:
 def _flow(scene: Scene, document: VectorDocument, spec: LayerSpec) -> str:
     """The layer's motion source: its ``flow:``, by default the geometry wherever the input's kind is read."""
     if spec.flow is None:
-        return "vector" if document.reads_geometry else "masks"
-    if spec.flow == "vector" and not document.reads_geometry:
+        return "vector" if isinstance(document, GeometryDocument) else "masks"
+    if spec.flow == "vector" and not isinstance(document, GeometryDocument):
         raise scene.error(spec.flow_path, f"flow: vector reads the geometry of SVG files only so far, not of "
                           f"{document.kind} files ({scene.input.name}); use flow: masks")
     return spec.flow

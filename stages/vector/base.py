@@ -65,8 +65,6 @@ class VectorDocument(ABC):
     files: list[Path]
     unsupported: tuple[Unsupported, ...] = ()
     choices: dict[str, str] = {}
-    #: Whether :meth:`moving_elements` reads this kind's geometry (``flow: vector``).
-    reads_geometry: bool = False
 
     @abstractmethod
     def frame_range(self, fps: float) -> tuple[int, int]:
@@ -79,12 +77,16 @@ class VectorDocument(ABC):
     def layer_names(self) -> list[str]:
         return [layer.name for layer in self.layers]
 
+
+class GeometryDocument(VectorDocument):
+    """A document whose geometry is read for its motion (``flow: vector``; docs/guides.md)."""
+
+    @abstractmethod
     def moving_elements(self, names: Sequence[str], before_seconds: float, now_seconds: float,
                         size: tuple[int, int]) -> tuple[list, list[str]]:
         """The filled elements of layers ``names`` at ``now_seconds`` with where their outline points were at
         ``before_seconds``, in pixels of a raster of ``size`` (width, height), and what is drawn but not read
-        (:mod:`fluidymation.engine.vector_motion`). Kinds that set :attr:`reads_geometry` implement it."""
-        raise NotImplementedError(f"the geometry of {self.kind} files is not read")
+        (:mod:`fluidymation.engine.vector_motion`)."""
 
 
 class Renderer(ABC):

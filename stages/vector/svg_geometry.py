@@ -10,8 +10,8 @@ whose motion field no renderer is needed for (docs/guides.md, "Motion from the g
 Drawn here: ``path``, ``rect`` (rounded corners included), ``circle``, ``ellipse``,
 ``polygon`` and ``polyline`` with a fill, inside ``g`` groups and the root viewport
 (``viewBox``, ``preserveAspectRatio``). Anything else that is displayed (strokes, text,
-``use``, images, nested ``svg``) is named in :func:`moving_elements`'s second result, so
-the caller falls back to the masks there.
+``use``, images, nested ``svg``) is named in :func:`outlines`'s second result, so the
+caller falls back to the masks there.
 """
 
 from __future__ import annotations
@@ -186,16 +186,16 @@ def outlines(root: ElementTree.Element, out_size: tuple[int, int]) -> tuple[list
     return found, unread
 
 
-def moving_elements(before: ElementTree.Element, now: ElementTree.Element,
-                    out_size: tuple[int, int]) -> tuple[list[MovingElement], list[str]]:
-    """The elements of static tree ``now`` with where their outline points were in tree ``before``.
+def moving_elements(before: tuple[list[Outline], list[str]],
+                    now: tuple[list[Outline], list[str]]) -> tuple[list[MovingElement], list[str]]:
+    """The elements of frame ``now`` with where their outline points were in frame ``before``, each
+    frame given as :func:`outlines` found it.
 
     Returns the elements (painting order) and what is left to the masks: elements not read
-    (:func:`outlines`), new in ``now``, or whose outline changed its structure (points that
-    do not correspond).
+    in ``now``, new in it, or whose outline changed its structure (points that do not correspond).
     """
-    found_now, unread = outlines(now, out_size)
-    found_before = {outline.key: outline for outline in outlines(before, out_size)[0]}
+    found_now, unread = now[0], list(now[1])
+    found_before = {outline.key: outline for outline in before[0]}
     elements = []
     for outline in found_now:
         earlier = found_before.get(outline.key)

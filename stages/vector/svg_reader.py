@@ -15,6 +15,7 @@ file's tree with every animation applied at that time, in table order.
 from __future__ import annotations
 
 import copy
+import functools
 import math
 import re
 from abc import ABC, abstractmethod
@@ -26,7 +27,9 @@ import tinycss2
 
 from fluidymation.errors import InputError
 from fluidymation.stages.files import sequence_paths
-from fluidymation.stages.vector.base import DEFAULT_FPS, Reader, Unsupported, VectorDocument, VectorLayer, frames_in
+from fluidymation.stages.vector.base import (
+    DEFAULT_FPS, GeometryDocument, Reader, Unsupported, VectorLayer, frames_in,
+)
 from fluidymation.stages.vector.safety import check_svg_references, local_name, parse_xml, read_file
 
 INKSCAPE_LABEL = "{http://www.inkscape.org/namespaces/inkscape}label"
@@ -190,10 +193,8 @@ class SvgFrame(NamedTuple):
     source: str
 
 
-class _StaticTrees(VectorDocument):
+class _StaticTrees(GeometryDocument):
     """An SVG kind whose frames are static trees (``static_tree``): its geometry is read for motion."""
-
-    reads_geometry = True
 
     @abstractmethod
     def static_tree(self, names, time_seconds) -> ElementTree.Element:
@@ -202,7 +203,14 @@ class _StaticTrees(VectorDocument):
     def moving_elements(self, names, before_seconds, now_seconds, size):
         from fluidymation.stages.vector.svg_geometry import moving_elements  # it reads this module's helpers
 
-        return moving_elements(self.static_tree(names, before_seconds), self.static_tree(names, now_seconds), size)
+        names, size = tuple(names), tuple(size)
+        return moving_elements(self._outlines(names, before_seconds, size), self._outlines(names, now_seconds, size))
+
+    @functools.lru_cache(maxsize=2)  # frame j's outlines are frame j + 1's earlier ones
+    def _outlines(self, names: tuple[str, ...], time_seconds: float, size: tuple[int, int]):
+        from fluidymation.stages.vector.svg_geometry import outlines
+
+        return outlines(self.static_tree(list(names), time_seconds), size)
 
 
 class SvgDocument(_StaticTrees):

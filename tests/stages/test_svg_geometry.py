@@ -5,7 +5,7 @@ import pytest
 
 from fluidymation.engine.vector_motion import vector_flow
 from fluidymation.stages.vector import open_document
-from fluidymation.stages.vector.svg_geometry import moving_elements, outlines
+from fluidymation.stages.vector.svg_geometry import outlines
 
 from tests.scenes import gear_path
 
@@ -21,8 +21,7 @@ def _write(tmp_path, body, view="0 0 64 64"):
 
 def _flow(document, frame, size=SIZE):
     names = document.layer_names()
-    elements, unread = moving_elements(document.static_tree(names, (frame - 1) / FPS),
-                                       document.static_tree(names, frame / FPS), size)
+    elements, unread = document.moving_elements(names, (frame - 1) / FPS, frame / FPS, size)
     flow, owned = vector_flow(elements, (size[1], size[0]))
     return flow, owned, unread
 
