@@ -14,18 +14,76 @@ Laplace's equation (:func:`fluidymation.engine.flow.harmonic_fill`); affine fiel
 harmonic, so the two parts add up to the harmonic interpolation of the outline's motion.
 
 Elements are composited bottom to top: a pixel takes the motion of the topmost element
-covering its centre. Flows are float32 ``(H, W, 2)`` holding ``(dx, dy)`` in px/frame, y
-down, and, as elsewhere, ``flow[j]`` is the motion that brought the material to frame j.
+covering its centre. An element may be clipped (a Lottie layer's masks, its track matte,
+a precomp's bounds): it then covers only the part of its outline the clip regions leave.
+Flows are float32 ``(H, W, 2)`` holding ``(dx, dy)`` in px/frame, y down, and, as
+elsewhere, ``flow[j]`` is the motion that brought the material to frame j.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from fluidymation.engine._jit import kernel
 from fluidymation.engine.flow import harmonic_fill
+
+
+_CLIP_MODES = ("add", "subtract", "intersect", "difference")
+
+
+@dataclass(frozen=True)
+class ClipPart:
+    """One region of a :class:`Clip`: the union of ``elements``' coverage (their motion unused), complemented
+    when ``inverted``, combined with the parts before it by ``mode``: ``add`` (union), ``subtract``,
+    ``intersect`` or ``difference`` (exclusive or)."""
+
+    elements: tuple
+    mode: str = "add"
+    inverted: bool = False
+
+    def __post_init__(self):
+        if self.mode not in _CLIP_MODES:
+            raise ValueError(f"clip mode must be one of {', '.join(_CLIP_MODES)}, got {self.mode!r}")
+
+
+@dataclass(frozen=True)
+class Clip:
+    """A region an element is cut to: its parts combined in order, as Lottie combines a layer's masks.
+
+    The combination starts from everything when the first part subtracts or intersects,
+    else from nothing.
+    """
+
+    parts: tuple
+    _regions: dict = field(default_factory=dict, compare=False, repr=False)  # by raster shape: a clip shared by
+    # many elements (a precomp's bounds) is filled once
+
+    def region(self, shape: tuple[int, int]) -> np.ndarray:
+        """(H, W) bool: the pixels the clip leaves."""
+        shape = tuple(shape)
+        if shape not in self._regions:
+            self._regions[shape] = self._combined(shape)
+        return self._regions[shape]
+
+    def _combined(self, shape: tuple[int, int]) -> np.ndarray:
+        left = np.full(shape, bool(self.parts) and self.parts[0].mode in ("intersect", "subtract"))
+        for part in self.parts:
+            region = np.zeros(shape, bool)
+            for element in part.elements:
+                region |= coverage(element, shape)
+            if part.inverted:
+                region = ~region
+            if part.mode == "add":
+                left |= region
+            elif part.mode == "subtract":
+                left &= ~region
+            elif part.mode == "intersect":
+                left &= region
+            else:
+                left ^= region
+        return left
 
 
 @dataclass(frozen=True)
@@ -41,12 +99,16 @@ class MovingElement:
         or a hole; the last point joins the first).
     even_odd : bool
         The element's fill rule: even-odd, or nonzero winding.
+    clips : tuple of Clip
+        Regions the element is cut to (its layer's masks, a track matte): it covers what its
+        outline and every clip cover.
     """
 
     now: np.ndarray
     before: np.ndarray
     ring_starts: np.ndarray
     even_odd: bool = False
+    clips: tuple = ()
 
     def __post_init__(self):
         now = np.ascontiguousarray(self.now, np.float32)
@@ -106,10 +168,13 @@ def _coverage(points, ring_starts, even_odd, out):
 
 
 def coverage(element: MovingElement, shape: tuple[int, int]) -> np.ndarray:
-    """(H, W) bool: the pixels whose centre the element covers at frame j."""
-    out = np.zeros(shape, bool)
-    _coverage(element.now.astype(np.float64), element.ring_starts, bool(element.even_odd), out)
-    return out
+    """(H, W) bool: the pixels whose centre the element covers at frame j, cut to each of its clips."""
+    covered = np.zeros(shape, bool)
+    _coverage(element.now.astype(np.float64), element.ring_starts, bool(element.even_odd), covered)
+    for clip in element.clips:
+        if covered.any():
+            covered &= clip.region(shape)
+    return covered
 
 
 def _point_weights(element: MovingElement) -> np.ndarray:

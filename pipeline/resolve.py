@@ -14,7 +14,6 @@ from dataclasses import dataclass, replace
 from fluidymation.errors import InputError, SceneError
 from fluidymation.pipeline.scene import MAX_FRAMES, MAX_SIZE, LayerSpec, Scene
 from fluidymation.stages.vector import DEFAULT_FPS, Renderer, VectorDocument, open_document, renderer_for
-from fluidymation.stages.vector.base import GeometryDocument
 
 log = logging.getLogger(__name__)
 
@@ -26,12 +25,15 @@ class PlannedLayer:
     spec: LayerSpec
     vector_layers: tuple[str, ...]
     z: int
-    #: Where its motion comes from: ``vector`` (the geometry) or ``masks``.
-    flow: str = "masks"
 
     @property
     def name(self) -> str:
         return self.spec.name
+
+    @property
+    def flow(self) -> str:
+        """Where its motion comes from: ``vector`` (the geometry) or ``masks``."""
+        return self.spec.flow
 
     @property
     def dirname(self) -> str:
@@ -142,7 +144,7 @@ def _layers(scene: Scene, document: VectorDocument) -> tuple[PlannedLayer, ...]:
     z_of = {layer.name: layer.z for layer in document.layers}
     if scene.layers is None:
         specs = [_default_layer(scene, name) for name in dict.fromkeys(document.layer_names())]
-        return tuple(PlannedLayer(spec, (spec.name,), z_of[spec.name], _flow(scene, document, spec)) for spec in specs)
+        return tuple(PlannedLayer(spec, (spec.name,), z_of[spec.name]) for spec in specs)
     planned = []
     for index, spec in enumerate(scene.layers):
         chosen = []
@@ -153,19 +155,8 @@ def _layers(scene: Scene, document: VectorDocument) -> tuple[PlannedLayer, ...]:
                                  f"{scene.input.name}; its layers are: {', '.join(z_of) or '(none)'}")
             chosen.extend(name for name in matches if name not in chosen)
         chosen.sort(key=z_of.__getitem__)
-        planned.append(PlannedLayer(spec, tuple(chosen), max(z_of[name] for name in chosen),
-                                    _flow(scene, document, spec)))
+        planned.append(PlannedLayer(spec, tuple(chosen), max(z_of[name] for name in chosen)))
     return tuple(planned)
-
-
-def _flow(scene: Scene, document: VectorDocument, spec: LayerSpec) -> str:
-    """The layer's motion source: its ``flow:``, by default the geometry wherever the input's kind is read."""
-    if spec.flow is None:
-        return "vector" if isinstance(document, GeometryDocument) else "masks"
-    if spec.flow == "vector" and not isinstance(document, GeometryDocument):
-        raise scene.error(spec.flow_path, f"flow: vector reads the geometry of SVG files only so far, not of "
-                          f"{document.kind} files ({scene.input.name}); use flow: masks")
-    return spec.flow
 
 
 def _default_layer(scene: Scene, name: str) -> LayerSpec:

@@ -72,9 +72,8 @@ class LayerSpec:
     params: dict = field(default_factory=dict)
     #: Where in the scene file each of ``params`` was given (its key path), for error messages.
     param_paths: dict = field(default_factory=dict, compare=False)
-    #: ``vector``, ``masks`` or None (the geometry wherever the input's kind is read; docs/guides.md).
-    flow: str | None = None
-    flow_path: tuple = field(default=(), compare=False)
+    #: Where the layer's motion comes from: ``vector`` (the geometry; docs/guides.md) or ``masks``.
+    flow: str = "vector"
 
 
 @dataclass(frozen=True)
@@ -284,8 +283,7 @@ def _layer(check: Checker, where, allowed, exemplars: dict, base: LayerSpec | No
         opacity=check.number(where + ("opacity",), base.opacity if base else 1.0, minimum=0, maximum=1),
         params=(dict(base.params) if base else {}) | params,
         param_paths=(dict(base.param_paths) if base else {}) | {key: where + ("params", key) for key in params},
-        flow=check.text(where + ("flow",), base.flow if base else None, choices=FLOW_SOURCES),
-        flow_path=where + ("flow",) if check.has(where + ("flow",)) else base.flow_path if base else (),
+        flow=check.text(where + ("flow",), base.flow if base else "vector", choices=FLOW_SOURCES),
     )
 
 

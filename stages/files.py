@@ -20,6 +20,8 @@ from fluidymation.errors import InputError
 
 
 _PRINTF = re.compile(r"%0?(\d*)d")
+_UMASK = os.umask(0o022)
+os.umask(_UMASK)  # read once: written files get the mode a plain open() would give them, not mkstemp's 0600
 
 
 def is_sequence_pattern(text: str) -> bool:
@@ -45,13 +47,14 @@ def _natural_key(path: Path):
 
 @contextlib.contextmanager
 def atomic_path(path: str | os.PathLike):
-    """Yield a temporary path next to ``path``; on success rename it over ``path``."""
+    """Yield a temporary path next to ``path``; on success rename it over ``path`` (with the mode the umask gives)."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".part" + path.suffix, dir=path.parent)
     os.close(fd)
     try:
         yield Path(tmp)
+        os.chmod(tmp, 0o666 & ~_UMASK)
         os.replace(tmp, path)
     except BaseException:
         with contextlib.suppress(FileNotFoundError):

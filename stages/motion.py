@@ -12,10 +12,10 @@ from __future__ import annotations
 import numpy as np
 
 from fluidymation.engine.vector_motion import vector_flow
-from fluidymation.stages.vector.base import GeometryDocument
+from fluidymation.stages.vector.base import VectorDocument
 
 
-def frame_motion(document: GeometryDocument, names: tuple[str, ...], frame: int, fps: float,
+def frame_motion(document: VectorDocument, names: tuple[str, ...], frame: int, fps: float,
                  size: tuple[int, int], *, first: bool = False) -> tuple[np.ndarray, list[str]]:
     """Scene frame ``frame``'s flow (H, W, 2) float32, NaN where unknown, and the drawn elements not read.
 

@@ -1,6 +1,7 @@
 """Tiny scenes of the blob example for pipeline tests (quick to render, real end to end), and
 tiny masks and exemplars for the stylize tests."""
 
+import json
 from pathlib import Path
 
 import numpy as np
@@ -57,14 +58,33 @@ def spreading_wash(*, size: int, frames: int, seed: int, start_radius: float, gr
     return rgb, mask
 
 
+def gear_points(centre: tuple[float, float], inner: float, outer: float, teeth: int = 8) -> np.ndarray:
+    """(4·teeth, 2) vertices of a gear: ``teeth`` square teeth from radius ``inner`` to ``outer``."""
+    k = np.arange(4 * teeth)
+    radius = np.where(k % 4 % 3 == 0, inner, outer)
+    angle = 2 * np.pi * k / (4 * teeth)
+    return np.column_stack([centre[0] + radius * np.cos(angle), centre[1] + radius * np.sin(angle)])
+
+
 def gear_path(centre: tuple[float, float], inner: float, outer: float, teeth: int = 8) -> str:
-    """SVG path data of a gear: ``teeth`` square teeth from radius ``inner`` to ``outer`` (4 vertices each)."""
-    points = []
-    for k in range(4 * teeth):
-        radius = outer if k % 4 in (1, 2) else inner
-        angle = 2 * np.pi * k / (4 * teeth)
-        points.append(f"{centre[0] + radius * np.cos(angle):.4f},{centre[1] + radius * np.sin(angle):.4f}")
-    return "M" + " L".join(points) + " Z"
+    """SVG path data of :func:`gear_points`."""
+    return "M" + " L".join(f"{x:.4f},{y:.4f}" for x, y in gear_points(centre, inner, outer, teeth)) + " Z"
+
+
+def assert_turning(flow, owned, centre, degrees_per_frame, clockwise=True):
+    """``flow`` over ``owned`` is a turn about ``centre``: speed ω·r within 5 % and direction within 5° of the
+    tangent, 3 px from the centre on."""
+    omega = np.radians(degrees_per_frame)
+    yy, xx = np.nonzero(owned)
+    offset = np.column_stack([xx + 0.5, yy + 0.5]) - np.asarray(centre)
+    radius = np.hypot(offset[:, 0], offset[:, 1])
+    away = radius > 3.0
+    speed = np.hypot(*flow[yy, xx].T)
+    np.testing.assert_allclose(speed[away], omega * radius[away], rtol=0.05)
+    # a positive rotation turns x towards y: clockwise on screen (y down), tangent (−y, x)
+    tangent = np.arctan2(offset[:, 0], -offset[:, 1]) + (0.0 if clockwise else np.pi)
+    turn = np.angle(np.exp(1j * (np.arctan2(flow[yy, xx, 1], flow[yy, xx, 0]) - tangent)))
+    assert np.degrees(np.abs(turn[away])).max() < 5.0
 
 
 def turning_gear_svg(folder: Path) -> Path:
@@ -73,4 +93,28 @@ def turning_gear_svg(folder: Path) -> Path:
     path.write_text('<svg xmlns="http://www.w3.org/2000/svg" width="64" height="64"><g id="gear">'
                     f'<path d="{gear_path((32, 32), 15, 22)}"/><animateTransform attributeName="transform" '
                     'type="rotate" from="0 32 32" to="360 32 32" dur="3s" repeatCount="indefinite"/></g></svg>')
+    return path
+
+
+def still(value) -> dict:
+    """A Lottie property that keeps ``value``."""
+    return {"a": 0, "k": value}
+
+
+def lottie_path(points, closed: bool = True) -> dict:
+    """A Lottie path value through ``points`` with straight segments."""
+    points = np.asarray(points, float).tolist()
+    return {"v": points, "i": [[0, 0]] * len(points), "o": [[0, 0]] * len(points), "c": closed}
+
+
+def turning_gear_lottie(folder: Path) -> Path:
+    """``folder/gear.json``: the gear of :func:`turning_gear_svg` as a Lottie shape layer turned by its rotation."""
+    gear = {"ty": "sh", "ks": still(lottie_path(gear_points((32, 32), 15, 22)))}
+    fill = {"ty": "fl", "c": still([0, 0, 0, 1]), "o": still(100), "r": 1}
+    turn = {"a": 1, "k": [{"t": 0, "s": [0], "o": {"x": [0], "y": [0]}, "i": {"x": [1], "y": [1]}},
+                          {"t": 72, "s": [360]}]}
+    layer = {"ty": 4, "nm": "gear", "ind": 1, "ip": 0, "op": 72, "st": 0, "shapes": [gear, fill],
+             "ks": {"a": still([32, 32]), "p": still([32, 32]), "s": still([100, 100]), "r": turn, "o": still(100)}}
+    path = folder / "gear.json"
+    path.write_text(json.dumps({"v": "5.7.0", "fr": 24, "ip": 0, "op": 72, "w": 64, "h": 64, "layers": [layer]}))
     return path

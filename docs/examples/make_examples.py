@@ -1,11 +1,13 @@
 """Regenerate the README's example videos and stills in docs/examples/ from the bundled examples.
 
 Run from the repository: ``.venv/bin/python docs/examples/make_examples.py [NAME ...]``
-(names: wave, blob, squiggle, ablate-blob; default all). Each example scene is rendered
-with the installed ``fluidymation`` into its own ``examples/<name>/out/``; its video is
-copied here and five of its frames are laid side by side, 4 px apart, as ``<name>.jpg``.
+(names: wave, blob, squiggle, ablate-blob, flow-gear; default all). Each example scene is
+rendered with the installed ``fluidymation`` into its own ``examples/<name>/out/``; its video
+is copied here and five of its frames are laid side by side, 4 px apart, as ``<name>.jpg``.
 ``ablate-blob`` runs ``fluidymation ablate`` on the blob layer and keeps one frame of its
-side-by-side video.
+side-by-side video. ``flow-gear`` renders ``examples/gear`` twice, with its motion from the
+masks (``flow: masks``) and from the geometry (``flow: vector``, the default), and sets the
+two videos side by side, labelled (``flow-gear.mp4``; frame 24 as ``flow-gear.jpg``).
 """
 
 from __future__ import annotations
@@ -17,6 +19,10 @@ from pathlib import Path
 
 import imageio.v3 as iio
 import numpy as np
+
+from fluidymation.stages.encode import Params as EncodeParams
+from fluidymation.stages.encode import encode_mp4
+from fluidymation.stages.labels import label_strip
 
 REPOSITORY = Path(__file__).resolve().parents[2]
 HERE = Path(__file__).resolve().parent
@@ -55,15 +61,33 @@ def make_ablation() -> None:
     iio.imwrite(HERE / "ablate-blob.jpg", iio.imread(video, plugin="pyav", index=ABLATION_FRAME), quality=90)
 
 
+def make_flow_comparison() -> None:
+    gear = REPOSITORY / "examples" / "gear"
+    fluidymation("render", str(gear / "scene.yaml"))
+    masks_scene = gear / "out" / "masks" / "scene.yaml"  # the same scene with the masks' motion
+    masks_scene.parent.mkdir(parents=True, exist_ok=True)
+    masks_scene.write_text((gear / "scene.yaml").read_text().replace("input: gear.svg", "input: ../../gear.svg")
+                           .replace("output: {dir: out,", "output: {dir: .,") + "defaults: {flow: masks}\n")
+    fluidymation("render", str(masks_scene))
+    videos = [iio.imread(path, plugin="pyav") for path in (masks_scene.parent / "gear.mp4", gear / "out" / "gear.mp4")]
+    captions = label_strip(["flow: masks", "flow: vector"], width=videos[0].shape[2])
+    frames = [side_by_side([np.concatenate([(caption * 255).astype(np.uint8), video[index]])
+                            for caption, video in zip(captions, videos)]) for index in range(len(videos[0]))]
+    encode_mp4(frames, HERE / "flow-gear.mp4", params=EncodeParams(fps=24))
+    iio.imwrite(HERE / "flow-gear.jpg", frames[ABLATION_FRAME], quality=90)
+
+
 def main() -> None:
-    names = sys.argv[1:] or [*STILL_FRAMES, "ablate-blob"]
+    names = sys.argv[1:] or [*STILL_FRAMES, "ablate-blob", "flow-gear"]
     for name in names:
         if name == "ablate-blob":
             make_ablation()
+        elif name == "flow-gear":
+            make_flow_comparison()
         elif name in STILL_FRAMES:
             make_example(name)
         else:
-            sys.exit(f"unknown example {name!r}: choose from {', '.join([*STILL_FRAMES, 'ablate-blob'])}")
+            sys.exit(f"unknown example {name!r}: choose from {', '.join([*STILL_FRAMES, 'ablate-blob', 'flow-gear'])}")
 
 
 if __name__ == "__main__":

@@ -74,19 +74,16 @@ class VectorDocument(ABC):
     def isolate(self, names: Sequence[str], time_seconds: float) -> Any:
         """Only the layers ``names`` as shown at ``time_seconds``, in the form this kind's renderers draw."""
 
-    def layer_names(self) -> list[str]:
-        return [layer.name for layer in self.layers]
-
-
-class GeometryDocument(VectorDocument):
-    """A document whose geometry is read for its motion (``flow: vector``; docs/guides.md)."""
-
     @abstractmethod
     def moving_elements(self, names: Sequence[str], before_seconds: float, now_seconds: float,
                         size: tuple[int, int]) -> tuple[list, list[str]]:
         """The filled elements of layers ``names`` at ``now_seconds`` with where their outline points were at
         ``before_seconds``, in pixels of a raster of ``size`` (width, height), and what is drawn but not read
-        (:mod:`fluidymation.engine.vector_motion`)."""
+        (:mod:`fluidymation.engine.vector_motion`; ``flow: vector``, docs/guides.md). What is not read takes
+        the masks' estimate, so a kind whose geometry is not read at all names all of it."""
+
+    def layer_names(self) -> list[str]:
+        return [layer.name for layer in self.layers]
 
 
 class Renderer(ABC):

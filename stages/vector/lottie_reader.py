@@ -114,6 +114,18 @@ class LottieDocument(VectorDocument):
             self._isolated[key] = json.dumps(isolated, separators=(",", ":")).encode()
         return PlayerFrame(self._isolated[key], self.lottie_frame(time_seconds) - self.in_point)
 
+    def moving_elements(self, names, before_seconds, now_seconds, size):
+        from fluidymation.stages.vector.lottie_geometry import moving_elements
+
+        units: dict[int, set[int] | None] = {}
+        for unit in (unit for name in names for unit in self._units[name]):
+            if unit.child is None:
+                units[unit.layer] = None
+            elif units.get(unit.layer, set()) is not None:
+                units.setdefault(unit.layer, set()).add(unit.child)
+        return moving_elements(self.data, list(units.items()), self.lottie_frame(before_seconds),
+                               self.lottie_frame(now_seconds), tuple(size))
+
 
 def open_lottie(path: Path, *, split: tuple[str, ...] = (), fps: float | None = None,
                 animation: str | None = None, theme: str | None = None) -> LottieDocument:

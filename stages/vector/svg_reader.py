@@ -28,7 +28,7 @@ import tinycss2
 from fluidymation.errors import InputError
 from fluidymation.stages.files import sequence_paths
 from fluidymation.stages.vector.base import (
-    DEFAULT_FPS, GeometryDocument, Reader, Unsupported, VectorLayer, frames_in,
+    DEFAULT_FPS, Reader, Unsupported, VectorDocument, VectorLayer, frames_in,
 )
 from fluidymation.stages.vector.safety import check_svg_references, local_name, parse_xml, read_file
 
@@ -193,7 +193,7 @@ class SvgFrame(NamedTuple):
     source: str
 
 
-class _StaticTrees(GeometryDocument):
+class _StaticTrees(VectorDocument):
     """An SVG kind whose frames are static trees (``static_tree``): its geometry is read for motion."""
 
     @abstractmethod

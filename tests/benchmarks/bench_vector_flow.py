@@ -3,10 +3,12 @@
 Run: ``NUMBA_CACHE_DIR=.numba-cache .venv/bin/python tests/benchmarks/bench_vector_flow.py [--size 512]
 [--frames 24]``.
 
-Two SVG layers drawn at ``--size``² (issue 16 asks for 512×512: the geometry's motion may
+Four layers drawn at ``--size``² (issue 16 asks for 512×512: the geometry's motion may
 cost at most 2× the estimate's): the bundled ``examples/blob`` (three SMIL-animated
-ellipses and circles that grow and slide: affine parts, harmonic fill of nothing) and a
-gear turned by ``animateTransform`` (a rigid path of 32 vertices). For each, the time per
+ellipses and circles that grow and slide: affine parts, harmonic fill of nothing), a
+gear turned by ``animateTransform`` (a rigid path of 32 vertices), the bundled Lottie
+``examples/wave`` (its ``body``: a rotating ellipse layer) and the same gear as a Lottie
+layer turned by its rotation keyframes. For each, the time per
 frame of :func:`fluidymation.stages.motion.frame_motion` (reading both frames' geometry and
 painting the field), and of the guides computed from the masks alone against with that
 motion given (``compute_guides``: the estimate's multigrid solves and time smoothing
@@ -31,7 +33,7 @@ from fluidymation.stages.vector import open_document, renderer_for
 
 ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT))
-from tests.scenes import turning_gear_svg  # noqa: E402
+from tests.scenes import turning_gear_lottie, turning_gear_svg  # noqa: E402
 
 FPS = 24.0
 
@@ -61,14 +63,16 @@ def main():
     args = parser.parse_args()
     load = os.getloadavg()[0]
     print(f"{args.size}x{args.size}, {args.frames} frames, load average {load:.2f}; seconds per frame")
-    print(f"  {'layer':8s} {'geometry':>9s} {'guides (masks)':>15s} {'guides (vector)':>16s} {'vector / masks':>15s}")
+    print(f"  {'layer':10s} {'geometry':>9s} {'guides (masks)':>15s} {'guides (vector)':>16s} {'vector / masks':>15s}")
     with tempfile.TemporaryDirectory() as folder:
         folder = Path(folder)
         for name, path, layer in (("blob", ROOT / "examples" / "blob" / "blob.svg", "blob"),
-                                  ("gear", turning_gear_svg(folder), "gear")):
+                                  ("gear", turning_gear_svg(folder), "gear"),
+                                  ("wave", ROOT / "examples" / "wave" / "wave.json", "body"),
+                                  ("gear-lottie", turning_gear_lottie(folder), "gear")):
             times = measure(path, layer, args.size, args.frames, folder / name)
             ratio = (times["geometry"] + times["given"]) / times["estimated"]
-            print(f"  {name:8s} {times['geometry']:9.3f} {times['estimated']:15.3f} {times['given']:16.3f} "
+            print(f"  {name:10s} {times['geometry']:9.3f} {times['estimated']:15.3f} {times['given']:16.3f} "
                   f"{ratio:15.2f}")
     print("vector / masks: (geometry + guides with it) / guides from the masks alone")
 

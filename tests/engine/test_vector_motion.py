@@ -3,7 +3,7 @@ import math
 import numpy as np
 import pytest
 
-from fluidymation.engine.vector_motion import MovingElement, affine_fit, coverage, vector_flow
+from fluidymation.engine.vector_motion import Clip, ClipPart, MovingElement, affine_fit, coverage, vector_flow
 from tests.naive import naive_inside
 
 
@@ -94,3 +94,37 @@ def test_elements_check_their_points():
         MovingElement(now=np.zeros((3, 2)), before=np.zeros((3, 2)), ring_starts=[0, 2])
     with pytest.raises(ValueError, match="both be"):
         MovingElement(now=np.zeros((3, 2)), before=np.zeros((4, 2)), ring_starts=[0, 3])
+
+
+def _square(x0, y0, x1, y1):
+    points = np.array([(x0, y0), (x1, y0), (x1, y1), (x0, y1)], np.float32)
+    return MovingElement(now=points, before=points, ring_starts=[0, 4])
+
+
+@pytest.mark.parametrize("modes, inverted, expected", [
+    (("add",), (False,), lambda a, b: a),
+    (("add",), (True,), lambda a, b: ~a),
+    (("subtract",), (False,), lambda a, b: ~a),
+    (("intersect",), (False,), lambda a, b: a),
+    (("add", "add"), (False, False), lambda a, b: a | b),
+    (("add", "subtract"), (False, False), lambda a, b: a & ~b),
+    (("add", "intersect"), (False, True), lambda a, b: a & ~b),
+    (("add", "difference"), (False, False), lambda a, b: a ^ b),
+    (("subtract", "subtract"), (False, False), lambda a, b: ~a & ~b)])
+def test_clips_combine_their_parts_in_order(modes, inverted, expected):
+    shape = (20, 20)
+    a_element, b_element = _square(2, 2, 12, 12), _square(8, 8, 18, 18)
+    a, b = coverage(a_element, shape), coverage(b_element, shape)
+    clip = Clip(tuple(ClipPart((element,), mode, flip)
+                      for element, mode, flip in zip((a_element, b_element), modes, inverted)))
+    np.testing.assert_array_equal(clip.region(shape), expected(a, b))
+    whole = _square(0, 0, 20, 20)
+    clipped = MovingElement(now=whole.now, before=whole.before, ring_starts=whole.ring_starts, clips=(clip,))
+    np.testing.assert_array_equal(coverage(clipped, shape), expected(a, b))
+    flow, owned = vector_flow([clipped], shape)
+    np.testing.assert_array_equal(owned, expected(a, b))
+
+
+def test_clip_parts_check_their_mode():
+    with pytest.raises(ValueError, match="clip mode"):
+        ClipPart((), "multiply")

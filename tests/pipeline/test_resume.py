@@ -1,6 +1,7 @@
 """A render killed with SIGKILL and started again continues from its last finished frame."""
 
 import json
+import os
 import signal
 import subprocess
 from pathlib import Path
@@ -88,3 +89,13 @@ def test_a_restart_under_another_key_starts_over(tmp_path):
     assert not any(cache.begin("stylize", "blob", "key-b").iterdir())
     cache.commit("stylize", "blob", "key-b", [])
     assert not state.exists() and cache.lookup("stylize", "blob")["key"] == "key-b"
+
+
+def test_finished_files_get_the_mode_the_umask_gives_not_the_temporary_files(tmp_path):
+    from fluidymation.stages.files import write_text
+
+    umask = os.umask(0)
+    os.umask(umask)  # only read
+    write_text(tmp_path / "out.txt", "done")
+    assert (tmp_path / "out.txt").stat().st_mode & 0o777 == 0o666 & ~umask
+    assert list(tmp_path.iterdir()) == [tmp_path / "out.txt"]

@@ -1,5 +1,3 @@
-import math
-
 import numpy as np
 import pytest
 
@@ -7,7 +5,7 @@ from fluidymation.engine.vector_motion import vector_flow
 from fluidymation.stages.vector import open_document
 from fluidymation.stages.vector.svg_geometry import outlines
 
-from tests.scenes import gear_path
+from tests.scenes import assert_turning, gear_path
 
 FPS = 24.0
 SIZE = (64, 64)
@@ -26,20 +24,6 @@ def _flow(document, frame, size=SIZE):
     return flow, owned, unread
 
 
-def _assert_turning(flow, owned, centre, degrees_per_frame, clockwise=True):
-    omega = math.radians(degrees_per_frame)
-    yy, xx = np.nonzero(owned)
-    offset = np.column_stack([xx + 0.5, yy + 0.5]) - np.asarray(centre)
-    radius = np.hypot(offset[:, 0], offset[:, 1])
-    away = radius > 3.0
-    speed = np.hypot(*flow[yy, xx].T)
-    np.testing.assert_allclose(speed[away], omega * radius[away], rtol=0.05)
-    # a positive SVG rotation turns x towards y: clockwise on screen, tangent (−y, x)
-    tangent = np.arctan2(offset[:, 0], -offset[:, 1]) + (0.0 if clockwise else math.pi)
-    turn = np.angle(np.exp(1j * (np.arctan2(flow[yy, xx, 1], flow[yy, xx, 0]) - tangent)))
-    assert np.degrees(np.abs(turn[away])).max() < 5.0
-
-
 @pytest.mark.parametrize("shape", ["disk", "gear"])
 def test_a_smil_rotation_reads_omega_r_along_the_tangent(tmp_path, shape):
     drawn = ('<circle cx="32" cy="32" r="24"/>' if shape == "disk" else f'<path d="{gear_path((32, 32), 18, 26)}"/>')
@@ -47,7 +31,7 @@ def test_a_smil_rotation_reads_omega_r_along_the_tangent(tmp_path, shape):
                                 'from="0 32 32" to="360 32 32" dur="3s" repeatCount="indefinite"/></g>')
     flow, owned, unread = _flow(document, 5)
     assert unread == []
-    _assert_turning(flow, owned, (32, 32), 360 / (3 * FPS))
+    assert_turning(flow, owned, (32, 32), 360 / (3 * FPS))
 
 
 def test_a_css_rotation_in_a_scaled_viewbox_reads_in_output_pixels(tmp_path):
@@ -56,7 +40,7 @@ def test_a_css_rotation_in_a_scaled_viewbox_reads_in_output_pixels(tmp_path):
                                 f'<path id="gear" d="{gear_path((16, 16), 9, 13)}"/>', view="0 0 32 32")
     flow, owned, unread = _flow(document, 3, size=(128, 128))
     assert unread == []
-    _assert_turning(flow, owned, (64, 64), 360 / (2 * FPS), clockwise=False)
+    assert_turning(flow, owned, (64, 64), 360 / (2 * FPS), clockwise=False)
 
 
 def test_a_scaling_square_reads_the_analytic_field(tmp_path):
