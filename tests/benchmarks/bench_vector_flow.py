@@ -43,6 +43,7 @@ def measure(path: Path, layer: str, size: int, frames: int, folder: Path) -> dic
     renderer = renderer_for(document)
     raster = RasterParams(size=(size, size), fps=FPS)
     masks = [rasterize_frame(renderer, document, (layer,), j, raster).coverage for j in range(frames)]
+    motion.frame_motion(document, (layer,), frames, FPS, (size, size))  # warm-up: compiled kernels loaded
     started = time.perf_counter()
     flows = [motion.frame_motion(document, (layer,), j, FPS, (size, size), first=j == 0)[0] for j in range(frames)]
     geometry = (time.perf_counter() - started) / frames
