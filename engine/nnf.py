@@ -77,8 +77,12 @@ def _match_is_valid(frame, x, y, label, source_segment):
 
 @kernel
 def _flow_rotation(target_angle, source_angle, frame, x, y, tx, ty, flip):
-    """The flow-aligned rotation θ_T(q) − θ_S(p), plus π when ``flip``."""
-    theta = target_angle[ty, tx] - source_angle[frame, int(y + 0.5), int(x + 0.5)]
+    """The flow-aligned rotation θ_S(p) − θ_T(q), plus π when ``flip``.
+
+    A patch turned by θ samples the source at ``R(θ)`` times its target offsets, so a source
+    direction α shows in the target at α − θ: this θ lays the source flow onto the target's.
+    """
+    theta = source_angle[frame, int(y + 0.5), int(x + 0.5)] - target_angle[ty, tx]
     if flip:
         theta += math.pi
     return theta
@@ -167,7 +171,7 @@ def fill_random(nnf, *, target_segment, source_segment, seed, salt=0, replace_al
     replace_all : bool
         False keeps every match that is already valid (in range, same segment).
     rotation_mode : int
-        ``ROTATION_NONE`` (θ = 0) or ``ROTATION_FLOW`` (θ = θ_T − θ_S or that + π,
+        ``ROTATION_NONE`` (θ = 0) or ``ROTATION_FLOW`` (θ = θ_S − θ_T or that + π,
         from ``target_angle`` (H, W) and ``source_angle`` (T, Hs, Ws)).
     index : tuple, optional
         A precomputed :func:`segment_index` of ``source_segment``.

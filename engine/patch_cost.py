@@ -8,9 +8,9 @@ n×n window of
   codes over each feature's range, the weights scaled to match (see :class:`PatchCost`);
   features may further be scaled per target pixel by a weight map (e.g. the temporal
   modulation m(q)), evaluated at the window's target pixel;
-* optionally ``w_dir · min(|tan(S_dir + θ − T_dir)|, clamp)`` (orientation term);
+* optionally ``w_dir · min(|tan(S_dir − θ − T_dir)|, clamp)`` (orientation term);
 * optionally, when source and target flows point roughly opposite ways
-  (``cos(S_dir(p) + θ − T_dir(q)) < 0`` at the centres), a permutation of the source
+  (``cos(S_dir(p) − θ − T_dir(q)) < 0`` at the centres), a permutation of the source
   features (e.g. swap ext+ and ext−).
 
 Summation stops early once the partial sum exceeds a bound (the search's current best).
@@ -118,7 +118,7 @@ def _patch_cost(cost, tx, ty, frame, x, y, theta, bound):
     opposite = False
     if cost.use_opposite:
         centre_angle = source_angle[frame, int(y + 0.5), int(x + 0.5)]
-        opposite = math.cos(centre_angle + theta - target_angle[ty, tx]) < 0.0
+        opposite = math.cos(centre_angle - theta - target_angle[ty, tx]) < 0.0
     total = np.float32(0.0)
     sx = int(x)
     sy = int(y)
@@ -195,7 +195,7 @@ def _patch_cost(cost, tx, ty, frame, x, y, theta, bound):
             if orientation_weight > 0.0:
                 nearest_x = int(min(max(sample_x + 0.5, 0.0), source_width - 1.0))
                 nearest_y = int(min(max(sample_y + 0.5, 0.0), source_height - 1.0))
-                turn = source_angle[frame, nearest_y, nearest_x] + theta - target_angle[qy, qx]
+                turn = source_angle[frame, nearest_y, nearest_x] - theta - target_angle[qy, qx]
                 total += orientation_weight * min(abs(math.tan(turn)), orientation_clamp)
         if total > bound:
             return total
@@ -277,7 +277,7 @@ def _rotated_cost(cost, tx, ty, frame, x, y, theta, cos_t, sin_t, opposite, boun
             if orientation_weight > 0.0:
                 nearest_x = int(sample_x + np.float32(0.5))
                 nearest_y = int(sample_y + np.float32(0.5))
-                turn = source_angle[frame, nearest_y, nearest_x] + theta - target_angle[qy, qx]
+                turn = source_angle[frame, nearest_y, nearest_x] - theta - target_angle[qy, qx]
                 total += orientation_weight * min(abs(math.tan(turn)), orientation_clamp)
             if total > bound:
                 return total
@@ -286,12 +286,12 @@ def _rotated_cost(cost, tx, ty, frame, x, y, theta, cos_t, sin_t, opposite, boun
 
 @inline_kernel
 def _centre_turn(cost, frame, sx, sy, theta, tx, ty):
-    """``cos(S_dir + θ − T_dir)`` between the integer source centre ``(frame, sx, sy)`` and
+    """``cos(S_dir − θ − T_dir)`` between the integer source centre ``(frame, sx, sy)`` and
     target pixel ``(tx, ty)``, or 1 when the cost swaps no features: where it is negative
     :func:`_rotated_cost` is to compare the swapped features (``opposite``)."""
     if not cost.use_opposite:
         return 1.0
-    return math.cos(cost.source_angle[frame, sy, sx] + theta - cost.target_angle[ty, tx])
+    return math.cos(cost.source_angle[frame, sy, sx] - theta - cost.target_angle[ty, tx])
 
 
 @inline_kernel

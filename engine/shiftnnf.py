@@ -35,7 +35,7 @@ def _shift(frame_in, coords_in, target_motion, target_angle, source_ext_plus, so
             sx = min(max(int(coords_in[ty, tx, 0] + 0.5), 0), source_width - 1)
             sy = min(max(int(coords_in[ty, tx, 1] + 0.5), 0), source_height - 1)
             theta = coords_in[ty, tx, 2]
-            opposite = math.cos(source_angle[frame, sy, sx] + theta - target_angle[ty, tx]) < 0.0
+            opposite = math.cos(source_angle[frame, sy, sx] - theta - target_angle[ty, tx]) < 0.0
             wanted = target_motion[ty, tx]
             best_frame = frame
             best_gap = abs(wanted)
@@ -60,7 +60,7 @@ def shift_nnf(nnf, *, target_motion, target_angle, source_ext_plus, source_ext_m
     """SHIFTNNF: the previous frame's field moved along source time to match the target motion.
 
     For each match ``(i, x, y, θ)`` at target pixel q (source values read at the nearest
-    pixel to ``(x, y)``): if ``cos(S_dir(i, p) + θ − T_dir(q)) ≥ 0`` find ``Δi ≥ 0``
+    pixel to ``(x, y)``): if ``cos(S_dir(i, p) − θ − T_dir(q)) ≥ 0`` find ``Δi ≥ 0``
     minimising ``|target_motion(q) − (S_ext+(i + Δi, p) − S_ext+(i, p))|``, otherwise
     ``Δi ≤ 0`` minimising ``|target_motion(q) − (S_ext−(i + Δi, p) − S_ext−(i, p))|``;
     ties go to the smallest ``|Δi|``. ``x, y, θ`` are kept.

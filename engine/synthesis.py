@@ -69,9 +69,10 @@ class SynthesisParams:
         Strength (0–1) with which each vote's colour histogram is matched, per segment, to
         the source frames its matches use (:mod:`fluidymation.engine.histogram`); 0: off.
     orientation_weight, orientation_clamp : float
-        Weight and clamp of the ``|tan(S_dir + θ − T_dir)|`` term (needs the angles).
+        Weight and clamp of the ``|tan(S_dir − θ − T_dir)|`` term (needs the angles).
     rotation : {"none", "flow"}
-        θ = 0, or the two flow-aligned angles θ_T − θ_S and θ_T − θ_S + π.
+        θ = 0, or the two flow-aligned angles θ_S − θ_T and θ_S − θ_T + π (a patch turned by θ
+        samples the source at R(θ) times its offsets: a source direction α shows at α − θ).
     seed : int
     tile_rows : int
         Height of the fixed parallel tiles.

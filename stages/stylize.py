@@ -5,7 +5,7 @@ Every target frame is synthesized from patches of the whole moving exemplar
 patch distance
 
     |rgb|² + w_bound |shape|² + w_edge |df|² + w_ext (|ext+|² + |ext−|²) + m(q) w_temp |temp|²
-    + w_dir |tan(S_dir + θ − T_dir)| + w_uni λ Ω/ω*
+    + w_dir |tan(S_dir − θ − T_dir)| + w_uni λ Ω/ω*
 
 (ext± divided by ``ext_unit``; ext+ and ext− swapped where source and target flows are
 opposite), segment-restricted matching (border/interior), two flow-aligned rotations per

@@ -256,7 +256,7 @@ def naive_shift_frames(frames, coords, motion, target_angle, ext_plus, ext_minus
             continue
         sx = min(max(int(math.floor(coords[ty, tx, 0] + 0.5)), 0), width - 1)
         sy = min(max(int(math.floor(coords[ty, tx, 1] + 0.5)), 0), height - 1)
-        turn = float(source_angle[i, sy, sx]) + float(coords[ty, tx, 2]) - float(target_angle[ty, tx])
+        turn = float(source_angle[i, sy, sx]) - float(coords[ty, tx, 2]) - float(target_angle[ty, tx])
         if math.cos(turn) < 0:
             options = [(abs(motion[ty, tx] - (ext_minus[k, sy, sx] - ext_minus[i, sy, sx])), i - k, k) for k in range(i, -1, -1)]
         else:

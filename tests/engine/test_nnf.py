@@ -119,4 +119,4 @@ def test_random_fill_keeps_valid_matches_and_uses_flow_angles():
                 replace_all=False, rotation_mode=ROTATION_FLOW, target_angle=target_angle, source_angle=source_angle)
     np.testing.assert_array_equal(field.coords[0, 0], (4, 4, 0.5))
     thetas = field.coords[:, :, 2].ravel()[1:]
-    assert np.all(np.isclose(thetas, 0.75) | np.isclose(thetas, 0.75 + np.pi))
+    assert np.all(np.isclose(thetas, -0.75) | np.isclose(thetas, -0.75 + np.pi))  # θ_S − θ_T (+ π)

@@ -92,7 +92,7 @@ def test_orientation_term_and_opposite_swap():
     weights = np.array([1.0, 0.5, 0.25, 2.0, 2.0])
     source_swapped = source[..., [0, 1, 2, 4, 3]]
     for ty, tx in [(3, 3), (0, 7), (6, 1)]:
-        opposite = np.cos(source_angle[1, 4, 5] + 0.3 - target_angle[ty, tx]) < 0
+        opposite = np.cos(source_angle[1, 4, 5] - 0.3 - target_angle[ty, tx]) < 0
         reference = source_swapped if opposite else source
         assert swap[ty, tx] == pytest.approx(naive_patch_cost(reference, target, weights, 1, 5, 4, 0.3, tx, ty, 5), rel=1e-4)
         extra = 0.0
@@ -103,7 +103,7 @@ def test_orientation_term_and_opposite_swap():
                     px = 5 + np.cos(0.3) * dx - np.sin(0.3) * dy
                     py = 4 + np.sin(0.3) * dx + np.cos(0.3) * dy
                     sa = source_angle[1, int(min(max(py + 0.5, 0), 8)), int(min(max(px + 0.5, 0), 9))]
-                    extra += 0.5 * min(abs(np.tan(sa + 0.3 - target_angle[qy, qx])), 3.0)
+                    extra += 0.5 * min(abs(np.tan(sa - 0.3 - target_angle[qy, qx])), 3.0)
         assert orient[ty, tx] == pytest.approx(base[ty, tx] + extra, rel=1e-4)
 
 

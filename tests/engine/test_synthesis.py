@@ -56,6 +56,34 @@ def test_flow_rotation_reproduces_a_rotated_source():
     assert np.mean(np.isclose(thetas, np.pi / 2, atol=1e-3) | np.isclose(thetas, 3 * np.pi / 2, atol=1e-3)) > 0.99
 
 
+def _stripe_direction(image):
+    """The direction (degrees in (−90, 90]) the image's stripes run along: across its mean structure tensor's gradient."""
+    gy, gx = np.gradient(image)
+    jxx, jyy, jxy = (gx * gx).mean(), (gy * gy).mean(), (gx * gy).mean()
+    return (np.degrees(0.5 * np.arctan2(2 * jxy, jxx - jyy)) + 180.0) % 180.0 - 90.0
+
+
+@pytest.mark.parametrize("source_degrees, target_degrees", [(0, 45), (30, 80), (-20, 35)])
+def test_flow_rotation_lays_the_source_flow_along_the_targets(source_degrees, target_degrees):
+    """Stripes along the source flow come out along the target flow at oblique angles too (a quarter turn cannot
+    tell an alignment from a mirroring about the source flow)."""
+    ys, xs = np.mgrid[0:64, 0:64]
+    along = np.radians(source_degrees)
+    stripes = 0.5 + 0.5 * np.sin(2 * np.pi * (np.cos(along) * ys - np.sin(along) * xs) / 8)
+    inputs = SynthesisInputs(
+        source_colour=np.repeat(stripes[None, ..., None], 3, axis=3).astype(np.float32),
+        source_guides=np.zeros((1, 64, 64, 1), np.float32), target_guides=np.zeros((48, 48, 1), np.float32),
+        colour_weights=np.ones(3, np.float32), guide_weights=np.zeros(1, np.float32),
+        source_angle=np.full((1, 64, 64), along, np.float32),
+        target_angle=np.full((48, 48), np.radians(target_degrees), np.float32))
+    result = synthesize(inputs, SynthesisParams(seed=1, rotation="flow", search_vote_iters=(4,), patchmatch_iters=(4,)))
+    assert abs(_stripe_direction(stripes) - source_degrees) < 3.0  # the estimate itself
+    turn = np.mod(np.degrees(result.nnf.coords[..., 2]) - (source_degrees - target_degrees), 180.0)
+    assert np.all(np.isclose(turn, 0.0, atol=1e-3) | np.isclose(turn, 180.0, atol=1e-3))  # θ = θ_S − θ_T (+ π)
+    # the patches' seams bend the stripes a little; a mirroring would put them 70–110° off
+    assert abs(_stripe_direction(result.image[6:-6, 6:-6, 0]) - target_degrees) < 10.0
+
+
 def test_uniformity_uses_more_of_the_source():
     # every target pixel asks for the same guide value, so without uniformity a few
     # source patches around x = 20 get used over and over (wash-out)
