@@ -1,4 +1,4 @@
-"""Reuse of the previous frame's field: SHIFTNNF and the temporal modulation m(q).
+"""Reuse of the previous frame's field: SHIFTNNF, the temporal modulation m(q) and transport (``carry``).
 
 :func:`shift_nnf` moves every match ``(i, x, y, θ)`` of frame ``j − 1`` forward (or, where
 the rotated source flow opposes the target flow, backward) in source time by the ``Δi``
@@ -7,6 +7,9 @@ whose source motion amount best matches the target's motion amount between frame
 frames"). :func:`temporal_modulation` is the per-pixel factor m(q) of the temporal term:
 0 where q was outside the previous mask, else 1 when the target and source distances
 differ by at most ``lower`` and 0 when by ``upper`` or more, smooth in between.
+:func:`transport_nnf` moves the field along the target's motion, turning each match with
+the motion's local rotation, so that the texture travels with the shape (``carry``, beyond
+the paper; docs/stylize.md).
 """
 
 from __future__ import annotations
@@ -162,3 +165,64 @@ def temporal_modulation(nnf, *, target_dist, source_dist, previous_mask, lower, 
         np.float32(lower), np.float32(upper), out,
     )
     return out
+
+
+@parallel_kernel
+def _transport(frame_in, coords_in, flow, turn, frame_out, coords_out, origin):
+    height, width = frame_in.shape
+    for ty in prange(height):
+        for tx in range(width):
+            # where the material now at (tx, ty) was in the previous frame
+            px = tx - flow[ty, tx, 0]
+            py = ty - flow[ty, tx, 1]
+            nx = int(math.floor(px + 0.5))
+            ny = int(math.floor(py + 0.5))
+            if not (0 <= nx < width and 0 <= ny < height) or frame_in[ny, nx] < 0:
+                frame_out[ty, tx] = -1
+                coords_out[ty, tx, 0] = 0.0
+                coords_out[ty, tx, 1] = 0.0
+                coords_out[ty, tx, 2] = 0.0
+                origin[ty, tx] = -1
+                continue
+            dx = px - nx
+            dy = py - ny
+            theta = coords_in[ny, nx, 2]
+            c = math.cos(theta)
+            s = math.sin(theta)
+            frame_out[ty, tx] = frame_in[ny, nx]
+            coords_out[ty, tx, 0] = coords_in[ny, nx, 0] + c * dx - s * dy
+            coords_out[ty, tx, 1] = coords_in[ny, nx, 1] + s * dx + c * dy
+            coords_out[ty, tx, 2] = theta + turn[ty, tx]
+            origin[ty, tx] = ny * width + nx
+
+
+def transport_nnf(nnf, flow):
+    """The previous frame's field carried along the target's motion ``flow`` (H, W, 2; frame j's: the motion that
+    brought the material to frame j).
+
+    Each target pixel q takes the match of the point it came from, p = q − flow(q): the
+    match of p's nearest pixel moved by the sub-pixel rest (through its rotation, as a vote
+    samples it) and turned by the rotation of the backward map q ↦ p there (from the
+    flow's derivatives), so a rigidly moving target votes the same texture, moved.
+
+    Returns
+    -------
+    carried : NNF
+        Unmatched where p leaves the image or its pixel had no match.
+    origin : ndarray, shape (H, W), int64
+        The flat index of p's nearest pixel (−1 where unmatched): other per-pixel state of
+        the previous frame is carried with ``previous.ravel()[origin]``.
+    """
+    height, width = nnf.shape
+    flow = np.ascontiguousarray(flow, np.float32)
+    if flow.shape != (height, width, 2):
+        raise ValueError(f"flow must have shape {(height, width, 2)}, got {flow.shape}")
+    d_fx_dy, d_fx_dx = np.gradient(flow[..., 0])
+    d_fy_dy, d_fy_dx = np.gradient(flow[..., 1])
+    # the backward map's Jacobian I − ∇flow, and the angle of its rotation part
+    turn = np.arctan2(d_fx_dy - d_fy_dx, 2.0 - d_fx_dx - d_fy_dy).astype(np.float32)
+    frame_out = np.empty((height, width), np.int32)
+    coords_out = np.empty((height, width, 3), np.float32)
+    origin = np.empty((height, width), np.int64)
+    _transport(nnf.frame, nnf.coords, flow, turn, frame_out, coords_out, origin)
+    return NNF(frame_out, coords_out), origin

@@ -145,6 +145,23 @@ def still_region(mask_before, mask_after, displacement, *, tolerance: float = 0.
             & (np.hypot(displacement[..., 0], displacement[..., 1]) < tolerance))
 
 
+def compensated_residual(before, after, displacement, mask_before, mask_after, *, margin: int = 3) -> float:
+    """How much the texture changes apart from the shape's motion: mean |after(q) − before(q − d(q))| (R, G, B
+    averaged; ``before`` sampled bilinearly) over the pixels ``margin`` px inside ``mask_after`` whose origin
+    q − d(q) lies ``margin`` px inside ``mask_before``; ``displacement`` (H, W, 2) is the shape's motion d into
+    the later frame. Near 0 when the paint
+    travels with the shape (``carry``)."""
+    height, width = mask_after.shape
+    ys, xs = np.mgrid[:height, :width].astype(np.float64)
+    origin_y, origin_x = ys - displacement[..., 1], xs - displacement[..., 0]
+    kept_before = ndimage.binary_erosion(inside(mask_before), iterations=margin)
+    came_from = ndimage.map_coordinates(kept_before.astype(np.float64), [origin_y, origin_x], order=0, cval=0.0) > 0
+    region = ndimage.binary_erosion(inside(mask_after), iterations=margin) & came_from
+    moved = np.stack([ndimage.map_coordinates(np.asarray(before[..., c], np.float64), [origin_y, origin_x], order=1,
+                                              mode="nearest") for c in range(3)], axis=-1)
+    return float(change(moved, after)[region].mean()) if region.any() else float("nan")
+
+
 def moving_band(mask_before, mask_after, *, width: float = 10.0, motion: float = 0.5) -> np.ndarray:
     """Pixels near an edge that moves: inside both masks, within ``width`` px of the edge in the
     later frame, and whose edge distance changes by at least ``motion`` px."""

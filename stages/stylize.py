@@ -35,7 +35,7 @@ from scipy import ndimage
 
 from fluidymation.engine.nnf import NNF
 from fluidymation.engine.random import counter_hash
-from fluidymation.engine.shiftnnf import shift_nnf, temporal_modulation
+from fluidymation.engine.shiftnnf import shift_nnf, temporal_modulation, transport_nnf
 from fluidymation.engine.synthesis import SynthesisParams, TargetInputs, concatenate_prepared, synthesize_prepared
 from fluidymation.engine.synthesis import prepare_source as prepare_engine_source
 from fluidymation.engine.vote import vote
@@ -44,7 +44,7 @@ from fluidymation.stages import guides
 from fluidymation.stages.exemplar_store import Source, StoredSource, border_clamped, concatenate
 
 NAME = "stylize"
-VERSION = 5
+VERSION = 6  # 6: flow-aligned rotations lay the source flow along the target's (were mirrored)
 
 #: Target guide channels, in order; the source compares shape, ext+, ext− and its colour (as S_temp).
 _GUIDES = ("shape", "edge", "ext_plus", "ext_minus", "temp_r", "temp_g", "temp_b")
@@ -99,6 +99,11 @@ class Params:
         None: ``floor(log2(d_min / n))`` capped so the coarsest level fits 2n + 1.
     reverse : bool
         Synthesize from the last frame to the first (material being added).
+    carry : bool
+        Carry the previous frame's matches along the target's motion before the
+        exemplar-time shift, so the texture travels with the shape (a painted wheel
+        turning); False: the paper, the paint stays on the paper and flows at moving
+        edges (beyond the paper; docs/stylize.md).
     settle_passes : int
         Times a fresh start (the first frame processed) is synthesized again with itself
         as the previous frame, so the next frames do not re-trade its unconverged matches
@@ -141,6 +146,7 @@ class Params:
     guided_init: bool = True
     pyramid_levels: int | None = None
     reverse: bool = False
+    carry: bool = False
     settle_passes: int = 3
     keep_margin: float = 0.2
     still_speed: float = 0.05
@@ -293,7 +299,8 @@ class _Previous(NamedTuple):
     inside: np.ndarray  #: (H, W) bool, where the layer covers it
     ext_plus: np.ndarray  #: (H, W) float32, its ext+ guide: the motion since is measured from it
     backlog: np.ndarray  #: (H, W) float32, the motion it has not yet followed
-    rgb: np.ndarray | None  #: (H, W, 3) its colour, kept where its paint is unchanged (None while it settles)
+    #: (H, W, 3) its colour, kept where its paint is unchanged (None while it settles; NaN where carried, moved)
+    rgb: np.ndarray | None
 
 
 def _resumed(resume: tuple, frame: guides.FrameGuides, mask, shape: tuple[int, int]) -> _Previous:
@@ -434,12 +441,49 @@ def _stylize_step(sequence: _Sequence, k: int, index: int, mask, previous: _Prev
         result, backlog = _fresh_start(sequence, k, frame, inside)
         rgb = np.clip(result.image, 0.0, 1.0)
     else:
+        if sequence.params.carry:
+            previous = _carried(previous, frame, target.frame(k - 1))
         result, backlog = _synthesize(sequence, k, frame, inside, previous, settle_pass=0)
         unchanged = _unchanged_paint(result.nnf, previous.nnf, sequence.params.patch_size)
+        unchanged &= np.isfinite(previous.rgb[..., 0])
         rgb = np.where(unchanged[..., None], previous.rgb, np.clip(result.image, 0.0, 1.0))
     rgba = np.concatenate([rgb, coverage[..., None]], axis=2)
     stylized = StylizedFrame(index=index, rgba=rgba, nnf=result.nnf, backlog=backlog)
     return stylized, _Previous(result.nnf, inside, frame.ext_plus, backlog, rgb)
+
+
+#: px: changes of the target's edge distance along its material smaller than this are none (``carry``)
+_DISTANCE_RESOLUTION = 0.5
+
+
+def _carried(previous: _Previous, frame: guides.FrameGuides, before: guides.FrameGuides) -> _Previous:
+    """The previous frame's state moved along the target's motion into ``frame`` (``carry``; ``before`` is the
+    previous frame's guides).
+
+    Its matches move by :func:`~fluidymation.engine.shiftnnf.transport_nnf`, the rest comes from the pixel each
+    point came from. The motion SHIFTNNF then follows in exemplar time is the target's motion relative to its
+    material, not the distance carried: how much farther from the edge each point got (the medium spreading;
+    none on a rigid part, and none where an edge closes in), counted from half a pixel, the resolution of the
+    distance fields (below it, their interpolation errors would add up frame after frame). It is given as the ext+ that makes that the
+    increment. The colour stays only where nothing moved (a moved colour is the vote's).
+    """
+    flow = frame.flow
+    nnf, origin = transport_nnf(previous.nnf, flow)
+    known = origin >= 0
+    height, width = known.shape
+    ys, xs = np.mgrid[:height, :width].astype(np.float32)
+    came_from = [ys - flow[..., 1], xs - flow[..., 0]]
+
+    def moved(values):  # sampled where each point came from
+        return np.where(known, ndimage.map_coordinates(values, came_from, order=1, mode="nearest"),
+                        np.float32(0.0)).astype(np.float32)
+
+    spread = frame.dist - moved(before.dist)
+    spread = np.where(spread > _DISTANCE_RESOLUTION, spread, 0.0)
+    inside = known & previous.inside.ravel()[np.where(known, origin, 0)]
+    rgb = np.where((known & np.all(flow == 0.0, axis=2))[..., None], previous.rgb, np.float32(np.nan))
+    return _Previous(nnf, inside, (frame.ext_plus - spread).astype(np.float32), moved(previous.backlog),
+                     rgb.astype(np.float32))
 
 
 def _fresh_start(sequence: _Sequence, k: int, frame: guides.FrameGuides, inside: np.ndarray):

@@ -5,9 +5,10 @@ Run from the repository: ``.venv/bin/python docs/examples/make_examples.py [NAME
 rendered with the installed ``fluidymation`` into its own ``examples/<name>/out/``; its video
 is copied here and five of its frames are laid side by side, 4 px apart, as ``<name>.jpg``.
 ``ablate-blob`` runs ``fluidymation ablate`` on the blob layer and keeps one frame of its
-side-by-side video. ``flow-gear`` renders ``examples/gear`` twice, with its motion from the
-masks (``flow: masks``) and from the geometry (``flow: vector``, the default), and sets the
-two videos side by side, labelled (``flow-gear.mp4``; frame 24 as ``flow-gear.jpg``).
+side-by-side video. ``flow-gear`` renders ``examples/gear`` three times, with its motion from
+the masks (``flow: masks``), from the geometry (``flow: vector``, the default) and from the
+geometry with the stylizer's ``carry: true``, and sets the videos side by side, labelled
+(``flow-gear.mp4``; frame 24 as ``flow-gear.jpg``).
 """
 
 from __future__ import annotations
@@ -64,13 +65,16 @@ def make_ablation() -> None:
 def make_flow_comparison() -> None:
     gear = REPOSITORY / "examples" / "gear"
     fluidymation("render", str(gear / "scene.yaml"))
-    masks_scene = gear / "out" / "masks" / "scene.yaml"  # the same scene with the masks' motion
-    masks_scene.parent.mkdir(parents=True, exist_ok=True)
-    masks_scene.write_text((gear / "scene.yaml").read_text().replace("input: gear.svg", "input: ../../gear.svg")
-                           .replace("output: {dir: out,", "output: {dir: .,") + "defaults: {flow: masks}\n")
-    fluidymation("render", str(masks_scene))
-    videos = [iio.imread(path, plugin="pyav") for path in (masks_scene.parent / "gear.mp4", gear / "out" / "gear.mp4")]
-    captions = label_strip(["flow: masks", "flow: vector"], width=videos[0].shape[2])
+    videos = []
+    for variant, defaults in (("masks", "{flow: masks}"), ("carry", "{params: {carry: true}}")):
+        scene = gear / "out" / variant / "scene.yaml"  # the same scene, the variant's defaults added
+        scene.parent.mkdir(parents=True, exist_ok=True)
+        scene.write_text((gear / "scene.yaml").read_text().replace("input: gear.svg", "input: ../../gear.svg")
+                         .replace("output: {dir: out,", "output: {dir: .,") + f"defaults: {defaults}\n")
+        fluidymation("render", str(scene))
+        videos.append(iio.imread(scene.parent / "gear.mp4", plugin="pyav"))
+    videos.insert(1, iio.imread(gear / "out" / "gear.mp4", plugin="pyav"))
+    captions = label_strip(["flow: masks", "flow: vector", "flow: vector, carry: true"], width=videos[0].shape[2])
     frames = [side_by_side([np.concatenate([(caption * 255).astype(np.uint8), video[index]])
                             for caption, video in zip(captions, videos)]) for index in range(len(videos[0]))]
     encode_mp4(frames, HERE / "flow-gear.mp4", params=EncodeParams(fps=24))

@@ -3,8 +3,8 @@
 Run: ``NUMBA_CACHE_DIR=.numba-cache .venv/bin/python tests/benchmarks/bench_flow_gear.py
 [docs/examples/flow-gear.mp4]``; the video is the one ``docs/examples/make_examples.py
 flow-gear`` writes (``examples/gear``: a gear turned a quarter turn in 2 s about
-(128, 128), 1.875° a frame, rendered with each flow; two 256-px panels under 14-px
-captions, 4 px apart).
+(128, 128), 1.875° a frame, rendered with each flow and with ``carry``; three 256-px panels
+under 14-px captions, 4 px apart).
 
 Over the gear's body between the hub and the teeth (radius 30–58 px), for each panel:
 
@@ -54,7 +54,7 @@ def main() -> None:
     body = (radius > 30) & (radius < 58)
     print(f"{video.name}: frames {FRAMES.start}..{FRAMES.stop - 1}, radius 30-58 px")
     print(f"  {'panel':8s} {'streaks along':>14s} {'coherence':>10s} {'texture motion / ωr':>20s} {'still':>6s}")
-    for index, name in enumerate(("masks", "vector")):
+    for index, name in enumerate(("masks", "vector", "carry")):
         left = index * (PANEL + GAP)
         panel = frames[FRAMES, CAPTION:CAPTION + PANEL, left:left + PANEL]
         alignments = np.array([tangent_alignment(frame.mean(axis=-1), tangent, body) for frame in panel])

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from fluidymation.engine.nnf import NNF
-from fluidymation.engine.shiftnnf import shift_nnf, temporal_modulation
+from fluidymation.engine.shiftnnf import shift_nnf, temporal_modulation, transport_nnf
 from tests.naive import naive_shift_frames
 
 
@@ -86,3 +86,41 @@ def test_bad_shapes_are_refused():
     with pytest.raises(ValueError):
         shift_nnf(_single(0, 0, 0, 0), target_motion=np.zeros((2, 2), np.float32), target_angle=np.zeros((1, 1), np.float32),
                   source_ext_plus=plus, source_ext_minus=minus, source_angle=angle)
+
+
+def _identity_field(height, width, frame=2):
+    """Every target pixel matched to the same source pixel, unturned."""
+    ys, xs = np.mgrid[0:height, 0:width].astype(np.float32)
+    return NNF(np.full((height, width), frame, np.int32), np.stack([xs, ys, np.zeros_like(xs)], axis=2))
+
+
+def test_transport_carries_matches_along_a_rigid_turn_and_turns_them_with_it():
+    size, omega, centre = 33, math.radians(3.0), 16.0
+    ys, xs = np.mgrid[0:size, 0:size].astype(np.float64)
+    c, s = math.cos(-omega), math.sin(-omega)
+    # where each point was a frame ago: turned back by ω about the centre
+    before_x = centre + c * (xs - centre) - s * (ys - centre)
+    before_y = centre + s * (xs - centre) + c * (ys - centre)
+    flow = np.stack([xs - before_x, ys - before_y], axis=2).astype(np.float32)
+    carried, origin = transport_nnf(_identity_field(size, size), flow)
+    inner = slice(2, -2)
+    np.testing.assert_allclose(carried.coords[inner, inner, 0], before_x[inner, inner], atol=1e-4)
+    np.testing.assert_allclose(carried.coords[inner, inner, 1], before_y[inner, inner], atol=1e-4)
+    np.testing.assert_allclose(carried.coords[inner, inner, 2], -omega, atol=1e-4)  # a vote turns it back by ω
+    came_in = (np.floor(before_x + 0.5) >= 0) & (np.floor(before_x + 0.5) < size) & \
+        (np.floor(before_y + 0.5) >= 0) & (np.floor(before_y + 0.5) < size)
+    np.testing.assert_array_equal(carried.frame, np.where(came_in, 2, -1))  # the corners came from outside
+    np.testing.assert_array_equal(origin, np.where(came_in, np.floor(before_y + 0.5) * size + np.floor(before_x + 0.5),
+                                                   -1))
+
+
+def test_transport_leaves_unmatched_what_came_from_outside_or_from_no_match():
+    field = _identity_field(6, 8)
+    field.frame[:, 0] = -1
+    flow = np.zeros((6, 8, 2), np.float32)
+    flow[..., 0] = 1.0  # everything moved one pixel right: column 0 came from outside, column 1 from no match
+    carried, origin = transport_nnf(field, flow)
+    assert np.all(carried.frame[:, :2] == -1) and np.all(origin[:, :2] == -1)
+    np.testing.assert_array_equal(carried.coords[:, 2:, 0], field.coords[:, 1:-1, 0])
+    with pytest.raises(ValueError, match="flow must have shape"):
+        transport_nnf(field, flow[:, :4])

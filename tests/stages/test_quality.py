@@ -141,3 +141,16 @@ def test_texture_fidelity_is_zero_for_exemplar_patches_and_grows_with_noise():
     assert 0.02 < noisy < 0.051  # the nearest patch is at most the noise's RMS away
     again = quality.texture_fidelity([shuffled + noise], [inner], [exemplar], [mask])
     assert again == noisy
+
+
+def test_compensated_residual_is_zero_for_texture_moved_with_the_shape():
+    rng = np.random.default_rng(3)
+    before = rng.random((32, 40, 3))
+    mask = np.zeros((32, 40))
+    mask[6:26, 6:30] = 1
+    after, mask_after = np.roll(before, 3, axis=1), np.roll(mask, 3, axis=1)
+    moved = np.broadcast_to(np.array([3.0, 0.0]), (32, 40, 2))
+    assert quality.compensated_residual(before, after, moved, mask, mask_after) == pytest.approx(0.0, abs=1e-12)
+    still = np.zeros((32, 40, 2))
+    assert quality.compensated_residual(before, after, still, mask, mask_after) > 0.2  # |U − U'| averages 1/3
+    assert np.isnan(quality.compensated_residual(before, after, moved, np.zeros_like(mask), mask_after))

@@ -8,7 +8,7 @@ import pytest
 from scipy import ndimage
 
 from fluidymation.errors import StageError
-from fluidymation.quality import gradient_profile, local_contrast
+from fluidymation.quality import compensated_residual, gradient_profile, local_contrast
 from fluidymation.stages import exemplar_builtin, exemplar_store, guides, stylize
 
 SIZE = 48
@@ -250,3 +250,36 @@ def test_no_seam_ring_where_the_border_and_interior_segments_meet(tmp_path):
     profile, _ = gradient_profile([frame.rgba[..., :3] for frame in frames], [disk] * 3)
     relative = profile / np.median(profile[3:20])
     assert relative[5] < 1.2  # band 5–6 px, just inside the split: measured 0.67 (1.61 before)
+
+
+def _turn(degrees):
+    """The displacement (SIZE, SIZE, 2) of a turn by ``degrees`` about the image centre (clockwise on screen)."""
+    angle, centre = np.radians(degrees), SIZE / 2 - 0.5
+    yy, xx = np.mgrid[:SIZE, :SIZE].astype(np.float64)
+    back_x = centre + np.cos(angle) * (xx - centre) + np.sin(angle) * (yy - centre)
+    back_y = centre - np.sin(angle) * (xx - centre) + np.cos(angle) * (yy - centre)
+    return np.stack([xx - back_x, yy - back_y], axis=-1).astype(np.float32)
+
+
+def _residuals(frames, masks, displacement):
+    return np.mean([compensated_residual(frames[j - 1].rgba, frames[j].rgba, displacement(j), masks(j - 1),
+                                         masks(j)) for j in range(1, len(frames))])
+
+
+@pytest.mark.parametrize("scene", ["turning disk", "moving disk"])
+def test_carry_moves_the_texture_with_the_shape(source, tmp_path, scene):
+    """With carry the paint travels with a turning (true motion given) or sliding disk: the motion-compensated
+    change is under half that of independent frames (measured 0.19 and 0.02); without it the paint stays on the
+    paper and changes more (0.65, 0.32)."""
+    if scene == "turning disk":
+        masks, displacement, given = (lambda j: _disk(SIZE / 2, radius=18)), (lambda j: _turn(6.0)), _turn(6.0)
+    else:
+        masks, displacement, given = moving, (lambda j: np.broadcast_to(np.float32([1, 0]), (SIZE, SIZE, 2))), None
+    residual = {}
+    for label, changes in (("paper", {}), ("carry", {"carry": True}), ("independent", {"w_temp": 0.0})):
+        frames = list(stylize.stylize_sequence(
+            masks, 6, source, params=dataclasses.replace(FAST, **changes), guide_params=GUIDES,
+            cache_dir=tmp_path / label, given_flow=None if given is None else (lambda j: given)))
+        residual[label] = _residuals(frames, masks, displacement)
+    assert residual["carry"] <= 0.5 * residual["independent"]
+    assert residual["carry"] < 0.5 * residual["paper"]
