@@ -86,6 +86,25 @@ class Clip:
         return left
 
 
+def stroke_rings(points: np.ndarray, half_width: float, closed: bool) -> list[np.ndarray]:
+    """The band within ``half_width`` of the line through ``points`` (N, 2) as rings to fill with nonzero winding.
+
+    Each point is offset to both sides along the line's normal there, so the same points at
+    two frames give offsets that correspond. A closed line gives two rings of opposite turn;
+    an open one a single ring around it, with flat ends. Joins are neither rounded nor
+    mitred: at a sharp corner the band is a little short on the outside.
+    """
+    points = np.asarray(points, np.float64)
+    if closed:
+        tangent = np.roll(points, -1, axis=0) - np.roll(points, 1, axis=0)
+    else:
+        tangent = np.gradient(points, axis=0) if len(points) > 1 else np.zeros_like(points)
+    length = np.linalg.norm(tangent, axis=1, keepdims=True)
+    normal = np.column_stack([-tangent[:, 1], tangent[:, 0]]) / np.maximum(length, 1e-12)
+    left, right = points + half_width * normal, points - half_width * normal
+    return [left, right[::-1]] if closed else [np.vstack([left, right[::-1]])]
+
+
 @dataclass(frozen=True)
 class MovingElement:
     """One filled element at frame j and where its outline points were at frame j − 1.

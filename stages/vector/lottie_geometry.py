@@ -29,7 +29,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from fluidymation.engine.vector_motion import Clip, ClipPart, MovingElement
+from fluidymation.engine.vector_motion import Clip, ClipPart, MovingElement, stroke_rings
 
 _PRECOMP, _SOLID, _NULL, _SHAPE = 0, 1, 3, 4
 _NOT_SHAPE_LAYERS = {2: "an image layer", 5: "a text layer"}
@@ -61,6 +61,7 @@ class _Ring:
     before: np.ndarray
     now: np.ndarray
     unread: str | None = None
+    closed: bool = True
 
 
 # --- properties ---------------------------------------------------------------------------------------------------
@@ -299,22 +300,22 @@ def _reversed(path: np.ndarray) -> np.ndarray:
     return np.stack([backwards[:, 0], backwards[:, 2], backwards[:, 1]], axis=1)
 
 
-def _shape_segments(shape: dict, frame: float) -> np.ndarray:
-    """A shape item's outline at ``frame`` as cubic segments in its group's coordinates."""
+def _shape_segments(shape: dict, frame: float) -> tuple[np.ndarray, bool]:
+    """A shape item's outline at ``frame`` as cubic segments in its group's coordinates, and whether it is closed."""
     kind = shape.get("ty")
     if kind == "sh":
         path, closed = _keyframed(shape.get("ks"), frame, _path)
-        return _segments(path, closed)
+        return _segments(path, closed), closed
     if kind == "sr":
-        return _segments(_star(shape, frame), True)
+        return _segments(_star(shape, frame), True), True
     center = _value(shape, "p", frame, [0.0, 0.0], spatial=True)
     size = _value(shape, "s", frame)
     if size.size < 2:
         raise _Unread(f"a size of {size.size} number(s)")
     reversed_ = _first(shape.get("d"), 1.0) == 3.0
     if kind == "el":
-        return _segments(_ellipse(center, size, reversed_), True)
-    return _segments(_rectangle(center, size, _scalar(shape, "r", frame, 0.0), reversed_), True)
+        return _segments(_ellipse(center, size, reversed_), True), True
+    return _segments(_rectangle(center, size, _scalar(shape, "r", frame, 0.0), reversed_), True), True
 
 
 def _placed(segments: np.ndarray, matrix: np.ndarray) -> np.ndarray:
@@ -341,8 +342,11 @@ class _Walk:
         self.elements: list[MovingElement] = []
         self.unread: list[str] = []
 
-    def group(self, items, matrices, frames: _Frames, where: str) -> list[_Ring]:
-        """Walk a shape group's ``items`` (top first); returns its paths for the fills below it."""
+    def group(self, items, matrices, frames: _Frames, where: str, taint: str | None = None) -> list[_Ring]:
+        """Walk a shape group's ``items`` (top first); returns its paths for the fills below it.
+
+        ``taint`` names a path modifier of an enclosing group: it changes every path inside, so
+        nothing painted here is read."""
         items = [item for item in items if isinstance(item, dict) and not item.get("hd")] if isinstance(
             items, list) else []
         transform = next((item for item in items if item.get("ty") == "tr"), None)
@@ -355,18 +359,20 @@ class _Walk:
                 return []
             matrices = [matrices[0] @ own[0], matrices[1] @ own[1]]
         modifier = next((item for item in items if item.get("ty") in _MODIFIERS), None)
-        taint = f"{where} (a {_MODIFIERS[modifier['ty']]})" if modifier is not None else None
+        if modifier is not None and taint is None:
+            taint = f"{where} (a {_MODIFIERS[modifier['ty']]})"
         rings: list[_Ring] = []
         for index, item in enumerate(items):
             kind, name = item.get("ty"), f"{where}[{index}] '{item.get('nm', '')}'"
             if kind == "gr":
-                rings += self.group(item.get("it"), matrices, frames, f"{name} it")
+                rings += self.group(item.get("it"), matrices, frames, f"{name} it", taint)
             elif kind in _SHAPES:
                 rings.append(self._ring(item, matrices, frames, name, taint))
             elif kind in _FILLS:
-                self._fill(item, rings, frames, name)
-            elif kind in _STROKES and rings:
-                self.unread.append(f"{name} (a stroke)")
+                self._paint(item, rings, frames, name, lambda drawn: _element(
+                    drawn, _first(item.get("r"), 1.0) == 2.0))
+            elif kind in _STROKES:
+                self._stroke(item, rings, matrices, frames, name)
         if taint is not None:
             for ring in rings:
                 ring.unread = ring.unread or taint
@@ -374,29 +380,47 @@ class _Walk:
 
     def _ring(self, item: dict, matrices, frames: _Frames, name: str, taint: str | None) -> _Ring:
         try:
-            before, now = (_placed(_shape_segments(item, frame), matrix)
-                           for frame, matrix in zip(frames.pair(), matrices))
+            (before, _), (now, closed) = (_shape_segments(item, frame) for frame in frames.pair())
+            before, now = _placed(before, matrices[0]), _placed(now, matrices[1])
         except _Unread as reason:
             return _Ring(np.zeros((0, 4, 2)), np.zeros((0, 4, 2)), f"{name} ({reason})")
         if before.shape != now.shape:
             return _Ring(before, now, f"{name} (its outline changed structure)")
-        return _Ring(before, now, taint)
+        return _Ring(before, now, taint, closed)
 
-    def _fill(self, fill: dict, rings: list[_Ring], frames: _Frames, name: str) -> None:
+    def _stroke(self, stroke: dict, rings: list[_Ring], matrices, frames: _Frames, name: str) -> None:
+        """A stroke of the paths above it: their outlines widened by its width (``w``, in its group's units)."""
+        if isinstance(stroke.get("d"), list) and stroke["d"]:
+            if rings:
+                self.unread.append(f"{name} (a dashed stroke)")
+            return
+        try:
+            widths = [_scalar(stroke, "w", frame, 0.0) * math.sqrt(abs(np.linalg.det(matrix[:2, :2])))
+                      for frame, matrix in zip(frames.pair(), matrices)]
+        except _Unread as reason:
+            self.unread.append(f"{name} ({reason})")
+            return
+        if widths[1] <= 0.0:
+            return
+        self._paint(stroke, rings, frames, name, lambda drawn: _stroke_element(drawn, widths))
+
+    def _paint(self, paint: dict, rings: list[_Ring], frames: _Frames, name: str, make) -> None:
+        """One element painted by ``paint`` (a fill or a stroke) over ``rings``: ``make(rings)``, unless it is
+        transparent or a ring is not read."""
         rings = [ring for ring in rings if ring.now.shape[0] or ring.unread is not None]
         if not rings:
             return
         try:
-            if _scalar(fill, "o", frames.now, 100.0) <= 0.0:
+            if _scalar(paint, "o", frames.now, 100.0) <= 0.0:
                 return
         except _Unread as reason:
             self.unread.append(f"{name} ({reason})")
             return
         reasons = [ring.unread for ring in rings if ring.unread is not None]
         if reasons:
-            self.unread.append(f"{name} (fills {reasons[0]})")
+            self.unread.append(f"{name} ({'strokes' if paint.get('ty') in _STROKES else 'fills'} {reasons[0]})")
             return
-        element = _element(rings, _first(fill.get("r"), 1.0) == 2.0)
+        element = make(rings)
         if element is None:
             self.unread.append(f"{name} (its outline is too large or out of range)")
         else:
@@ -436,8 +460,8 @@ class _Walk:
                 self.group(layer.get("shapes"), matrices, frames, f"{name} shapes")
             elif kind == _SOLID:
                 rectangle = _box(_first(layer.get("sw"), 0.0), _first(layer.get("sh"), 0.0))
-                self._fill({"r": 1}, [_Ring(_placed(rectangle, matrices[0]), _placed(rectangle, matrices[1]))],
-                           frames, name)
+                self._paint({}, [_Ring(_placed(rectangle, matrices[0]), _placed(rectangle, matrices[1]))],
+                            frames, name, lambda drawn: _element(drawn, False))
             elif kind == _PRECOMP:
                 self._precomp(layer, frames, matrices, composition, name, children, depth)
             else:
@@ -553,11 +577,31 @@ def _element(rings: list[_Ring], even_odd: bool) -> MovingElement | None:
         before_points.append(before)
         now_points.append(now)
         starts.append(starts[-1] + now.shape[0])
-    now, before = np.concatenate(now_points), np.concatenate(before_points)
-    if now.shape[0] > _MAX_POINTS or not (np.abs(now).max(initial=0.0) < _FARTHEST
+    return _checked_element(np.concatenate(now_points), np.concatenate(before_points), starts, even_odd)
+
+
+def _checked_element(now: np.ndarray, before: np.ndarray, starts: list[int], even_odd: bool) -> MovingElement | None:
+    if now.shape[0] > _MAX_POINTS or not (np.isfinite(now).all() and np.isfinite(before).all()
+                                          and np.abs(now).max(initial=0.0) < _FARTHEST
                                           and np.abs(before).max(initial=0.0) < _FARTHEST):
         return None
     return MovingElement(now=now, before=before, ring_starts=np.array(starts), even_odd=even_odd)
+
+
+def _stroke_element(rings: list[_Ring], widths: list[float]) -> MovingElement | None:
+    """The band within half a width of the rings' outlines at both frames (None: too large), by
+    :func:`~fluidymation.engine.vector_motion.stroke_rings` at each frame: a point's offsets move with it."""
+    before_points, now_points, starts = [], [], [0]
+    for ring in rings:
+        points = _cut(ring.before, ring.now)
+        if not ring.closed:  # the end point, which closing would have supplied
+            points = tuple(np.vstack([cut, segments[-1, 3]]) for cut, segments in zip(points, (ring.before, ring.now)))
+        bands = [stroke_rings(cut, width / 2.0, ring.closed) for cut, width in zip(points, widths)]
+        for before, now in zip(*bands):
+            before_points.append(before)
+            now_points.append(now)
+            starts.append(starts[-1] + now.shape[0])
+    return _checked_element(np.concatenate(now_points), np.concatenate(before_points), starts, False)
 
 
 def _cut(before: np.ndarray, now: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -3,7 +3,9 @@ import math
 import numpy as np
 import pytest
 
-from fluidymation.engine.vector_motion import Clip, ClipPart, MovingElement, affine_fit, coverage, vector_flow
+from fluidymation.engine.vector_motion import (
+    Clip, ClipPart, MovingElement, affine_fit, coverage, stroke_rings, vector_flow,
+)
 from tests.naive import naive_inside
 
 
@@ -128,3 +130,23 @@ def test_clips_combine_their_parts_in_order(modes, inverted, expected):
 def test_clip_parts_check_their_mode():
     with pytest.raises(ValueError, match="clip mode"):
         ClipPart((), "multiply")
+
+
+def _band(rings):
+    points = np.concatenate(rings).astype(np.float32)
+    return MovingElement(now=points, before=points, ring_starts=np.cumsum([0] + [len(ring) for ring in rings]))
+
+
+def test_a_stroke_band_covers_what_lies_within_half_its_width():
+    line = np.column_stack([np.linspace(4, 36, 17), np.full(17, 20.0)])
+    got = coverage(_band(stroke_rings(line, 3.0, closed=False)), (40, 40))
+    expected = np.zeros((40, 40), bool)
+    expected[17:23, 4:36] = True  # pixel centres within 3 px of y = 20, between the flat ends
+    np.testing.assert_array_equal(got, expected)
+    centre = np.array([20.0, 20.0])
+    ring = _circle(centre, 12.0)
+    yy, xx = np.mgrid[:40, :40] + 0.5
+    radius = np.hypot(xx - 20, yy - 20)
+    got = coverage(_band(stroke_rings(ring, 2.5, closed=True)), (40, 40))
+    sure = (radius > 9.7) & (radius < 14.3)
+    assert got[sure].all() and not got[(radius < 9.3) | (radius > 14.7)].any()  # the annulus, chords aside
