@@ -86,22 +86,32 @@ class Clip:
         return left
 
 
+_MITER_LIMIT = 4.0  # SVG's default stroke-miterlimit: a sharper corner's offset is cut to this many half widths
+
+
 def stroke_rings(points: np.ndarray, half_width: float, closed: bool) -> list[np.ndarray]:
     """The band within ``half_width`` of the line through ``points`` (N, 2) as rings to fill with nonzero winding.
 
-    Each point is offset to both sides along the line's normal there, so the same points at
-    two frames give offsets that correspond. A closed line gives two rings of opposite turn;
-    an open one a single ring around it, with flat ends. Joins are neither rounded nor
-    mitred: at a sharp corner the band is a little short on the outside.
+    Each point is offset to both sides by the miter of the normals of the segments meeting
+    there (along the normal on a smooth curve; at most ``_MITER_LIMIT`` half widths), so the
+    same points at two frames give offsets that correspond. A closed line gives two rings of
+    opposite turn; an open one a single ring around it, with flat ends.
     """
     points = np.asarray(points, np.float64)
+    following = np.roll(points, -1, axis=0) if closed else points[1:]
+    edges = following - (points if closed else points[:-1])
+    length = np.linalg.norm(edges, axis=1)
+    if not (length > 0).any():
+        return []
+    normals = np.column_stack([-edges[:, 1], edges[:, 0]]) / np.maximum(length, 1e-300)[:, None]
+    kept = np.flatnonzero(length > 0)  # a zero-length segment takes the normal of the nearest one before it
+    normals = normals[kept[np.maximum(np.searchsorted(kept, np.arange(len(edges)), side="right") - 1, 0)]]
     if closed:
-        tangent = np.roll(points, -1, axis=0) - np.roll(points, 1, axis=0)
+        before, after = np.roll(normals, 1, axis=0), normals
     else:
-        tangent = np.gradient(points, axis=0) if len(points) > 1 else np.zeros_like(points)
-    length = np.linalg.norm(tangent, axis=1, keepdims=True)
-    normal = np.column_stack([-tangent[:, 1], tangent[:, 0]]) / np.maximum(length, 1e-12)
-    left, right = points + half_width * normal, points - half_width * normal
+        before, after = np.vstack([normals[:1], normals]), np.vstack([normals, normals[-1:]])
+    miter = (before + after) / np.maximum(1.0 + (before * after).sum(axis=1), 2.0 / _MITER_LIMIT**2)[:, None]
+    left, right = points + half_width * miter, points - half_width * miter
     return [left, right[::-1]] if closed else [np.vstack([left, right[::-1]])]
 
 

@@ -141,7 +141,7 @@ def _unit(vector: tuple[float, float]) -> tuple[float, float]:
 
 def _drawing_polylines(path: PathData) -> tuple[list[list[tuple[float, float, float, float]]], tuple[float, float]]:
     """Each drawing command of ``path`` as a polyline of (x, y, tangent x, tangent y), absolute; the first point."""
-    polylines, _, first = _drawing_segments(path)
+    polylines, _, first, _ = _drawing_segments(path)
     return polylines, first
 
 
@@ -151,17 +151,24 @@ def subpath_rings(path: PathData) -> list[list[tuple[float, float]]]:
     Every command is cut into the same number of pieces whatever its arguments, so the same
     path at two times, command for command, gives rings whose points correspond.
     """
-    polylines, subpaths, _ = _drawing_segments(path)
-    rings: dict[int, list[tuple[float, float]]] = {}
+    return [ring for ring, _ in subpath_lines(path) if len(ring) >= 3]
+
+
+def subpath_lines(path: PathData) -> list[tuple[list[tuple[float, float]], bool]]:
+    """Each subpath of ``path`` as its points and whether ``Z`` closes it (as a stroke draws it), cut as
+    :func:`subpath_rings` cuts them."""
+    polylines, subpaths, _, closed = _drawing_segments(path)
+    lines: dict[int, list[tuple[float, float]]] = {}
     for polyline, subpath in zip(polylines, subpaths):
-        ring = rings.setdefault(subpath, [polyline[0][:2]])
-        ring.extend(point[:2] for point in polyline[1:])
-    return [ring for ring in rings.values() if len(ring) >= 3]
+        line = lines.setdefault(subpath, [polyline[0][:2]])
+        line.extend(point[:2] for point in polyline[1:])
+    return [(line, subpath in closed) for subpath, line in lines.items()]
 
 
 def _drawing_segments(path: PathData):
-    """(polylines, the subpath number of each, the first point) of :func:`_drawing_polylines`."""
-    polylines, subpaths, subpath = [], [], -1
+    """(polylines, the subpath number of each, the first point, the subpaths closed by ``Z``) of
+    :func:`_drawing_polylines`."""
+    polylines, subpaths, subpath, closed = [], [], -1, set()
     x = y = start_x = start_y = 0.0
     control = None  # the last curve's second control point, for S and T
     first = None
@@ -201,8 +208,9 @@ def _drawing_segments(path: PathData):
         subpaths.append(subpath)
         x, y = end
         if kind == "Z":  # a drawing command after closepath starts a new subpath at the same point
+            closed.add(subpath)
             subpath += 1
-    return polylines, subpaths, first or (0.0, 0.0)
+    return polylines, subpaths, first or (0.0, 0.0), closed
 
 
 def _line(start, end) -> list[tuple[float, float, float, float]]:

@@ -8,10 +8,11 @@ every transform, give :class:`~fluidymation.engine.vector_motion.MovingElement` 
 whose motion field no renderer is needed for (docs/guides.md, "Motion from the geometry").
 
 Drawn here: ``path``, ``rect`` (rounded corners included), ``circle``, ``ellipse``,
-``polygon`` and ``polyline`` with a fill, inside ``g`` groups and the root viewport
-(``viewBox``, ``preserveAspectRatio``). Anything else that is displayed (strokes, text,
-``use``, images, nested ``svg``) is named in :func:`outlines`'s second result, so the
-caller falls back to the masks there.
+``polygon`` and ``polyline`` with a fill or an undashed stroke (the band within half the
+``stroke-width`` of the outline, :func:`~fluidymation.engine.vector_motion.stroke_rings`),
+inside ``g`` groups and the root viewport (``viewBox``, ``preserveAspectRatio``). Anything
+else that is displayed (dashed strokes, text, ``line``, ``use``, images, nested ``svg``) is
+named in :func:`outlines`'s second result, so the caller falls back to the masks there.
 """
 
 from __future__ import annotations
@@ -20,14 +21,14 @@ from dataclasses import dataclass
 from xml.etree import ElementTree
 
 import numpy as np
-from fluidymation.engine.vector_motion import MovingElement
+from fluidymation.engine.vector_motion import MovingElement, stroke_rings
 from fluidymation.stages.vector.css_transform import (
     IDENTITY, Box, Matrix, matrix_of, multiply, origin_point, parse_origin, parse_svg_transform,
     resolve,
 )
 from fluidymation.stages.vector.css_syntax import tokens
 from fluidymation.stages.vector.safety import local_name
-from fluidymation.stages.vector.smil_path import PathData, subpath_rings
+from fluidymation.stages.vector.smil_path import PathData, subpath_lines, subpath_rings
 from fluidymation.stages.vector.svg_reader import style_property, svg_size
 
 _SHAPES = {"path", "rect", "circle", "ellipse", "polygon", "polyline"}
@@ -35,6 +36,9 @@ _CONTAINERS = {"g", "a", "switch"}
 _NO_BOX = Box(0.0, 0.0, 0.0, 0.0)
 #: Outline coordinates (output px) beyond this are left to the masks (float32 keeps them within 1 px).
 _FARTHEST = 1e7
+#: The inherited properties that decide what an element paints, with their initial values.
+_PAINT_DEFAULTS = {"fill": "black", "fill-rule": "nonzero", "stroke": "none", "stroke-width": "1",
+                   "stroke-dasharray": "none"}
 _NOT_DRAWN = {"defs", "title", "desc", "metadata", "style", "script", "clipPath", "mask", "linearGradient",
               "radialGradient", "pattern", "marker", "symbol", "filter", "animate", "animateTransform",
               "animateMotion", "set", "mpath"}
@@ -100,8 +104,9 @@ def _viewport(root: ElementTree.Element, out_size: tuple[int, int]) -> Matrix:
     return multiply(to_output, (scale, 0.0, 0.0, scale, shift_x - x * scale, shift_y - y * scale))
 
 
-def _path_data(element: ElementTree.Element) -> PathData | None:
-    """The element's outline as path data (None: nothing to fill)."""
+def _path_data(element: ElementTree.Element, *, stroked: bool = False) -> PathData | None:
+    """The element's outline as path data (None: nothing to draw); ``stroked``: as its stroke follows it (a
+    ``polyline`` stays open)."""
     kind = local_name(element.tag)
     if kind == "path":
         return PathData.parse(element.get("d") or "")
@@ -132,7 +137,28 @@ def _path_data(element: ElementTree.Element) -> PathData | None:
     if len(numbers) < 6:
         return None
     pairs = " ".join(f"{numbers[i]},{numbers[i + 1]}" for i in range(0, len(numbers) - 1, 2))
-    return PathData.parse(f"M{pairs} Z")
+    return PathData.parse(f"M{pairs}" if stroked and kind == "polyline" else f"M{pairs} Z")
+
+
+def _stroke_width(text: str) -> float:
+    try:
+        return float(text.strip().removesuffix("px"))
+    except ValueError:
+        raise ValueError(f"stroke-width '{text}' is not a number in px") from None
+
+
+def _stroke_outline(element: ElementTree.Element, key: tuple[int, ...], matrix: Matrix,
+                    width_text: str) -> Outline | None:
+    """The band the element's stroke paints (``stroke-width`` ``width_text``, scaled by ``matrix``), or None."""
+    width = _stroke_width(width_text)
+    data = _path_data(element, stroked=True)
+    if data is None or width <= 0:
+        return None
+    a, b, c, d, _, _ = matrix
+    half = width * abs(a * d - b * c) ** 0.5 / 2
+    rings = [ring for points, closed in subpath_lines(data) if len(points) >= 2
+             for ring in stroke_rings(_apply(matrix, points), half, closed)]
+    return Outline(key + (-1,), rings, False) if rings else None
 
 
 def _apply(matrix: Matrix, ring: list[tuple[float, float]]) -> np.ndarray:
@@ -149,40 +175,44 @@ def outlines(root: ElementTree.Element, out_size: tuple[int, int]) -> tuple[list
     found: list[Outline] = []
     unread: list[str] = []
 
-    def visit(element, key, matrix, fill, fill_rule, stroke):
+    def add(outline: Outline | None, kind: str, key) -> None:
+        if outline is not None and all(np.abs(ring).max() < _FARTHEST for ring in outline.rings):  # NaN fails too
+            found.append(outline)
+        elif outline is not None:
+            unread.append(f"<{kind}> at {key} (coordinates out of range)")
+
+    def visit(element, key, matrix, paint):
         if _attribute(element, "display") == "none":
             return
-        fill = _attribute(element, "fill") or fill
-        fill_rule = _attribute(element, "fill-rule") or fill_rule
-        stroke = _attribute(element, "stroke") or stroke
+        paint = {name: _attribute(element, name) or inherited for name, inherited in paint.items()}
         kind = local_name(element.tag)
         try:
             matrix = multiply(matrix, _transform(element))
             if kind in _SHAPES:
-                data = _path_data(element) if fill != "none" else None
+                data = _path_data(element) if paint["fill"] != "none" else None
+                stroked = paint["stroke"] != "none" and paint["stroke-dasharray"] == "none"
+                stroke = _stroke_outline(element, key, matrix, paint["stroke-width"]) if stroked else None
         except ValueError as error:  # drawn as the renderer reads it; its motion is left to the masks
             unread.append(f"<{kind}> at {key} ({error})")
             return
         if kind in _SHAPES:
-            if stroke != "none":
-                unread.append(f"<{kind}> at {key} (its stroke)")
             rings = [] if data is None else [_apply(matrix, ring) for ring in subpath_rings(data)]
-            if rings and all(np.abs(ring).max() < _FARTHEST for ring in rings):  # NaN fails too
-                found.append(Outline(key, rings, fill_rule == "evenodd"))
-            elif rings:
-                unread.append(f"<{kind}> at {key} (coordinates out of range)")
+            add(Outline(key, rings, paint["fill-rule"] == "evenodd") if rings else None, kind, key)
+            if paint["stroke"] != "none" and not stroked:
+                unread.append(f"<{kind}> at {key} (its dashed stroke)")
+            add(stroke, kind, key)
             return
         if kind in _CONTAINERS:
             for index, child in enumerate(element):
-                visit(child, key + (index,), matrix, fill, fill_rule, stroke)
+                visit(child, key + (index,), matrix, paint)
             return
         if kind not in _NOT_DRAWN and isinstance(element.tag, str):
             unread.append(f"<{kind}> at {key}")
 
     viewport = _viewport(root, out_size)
+    paint = {name: _attribute(root, name) or default for name, default in _PAINT_DEFAULTS.items()}
     for index, child in enumerate(root):
-        visit(child, (index,), viewport, _attribute(root, "fill") or "black", _attribute(root, "fill-rule") or "nonzero",
-              _attribute(root, "stroke") or "none")
+        visit(child, (index,), viewport, paint)
     return found, unread
 
 

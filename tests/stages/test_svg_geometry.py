@@ -64,12 +64,12 @@ def test_a_path_morph_moves_with_its_vertices(tmp_path):
     assert abs(flow[25, 11, 0]) < 0.05 and np.abs(flow[owned][:, 1]).max() < 1e-3
 
 
-def test_strokes_hidden_layers_and_other_elements_are_named_or_left_out(tmp_path):
-    document = _write(tmp_path, '<g id="a"><circle cx="20" cy="20" r="8" stroke="red"/><text>hi</text></g>'
-                                '<g id="b"><rect width="10" height="10" fill="none"/></g>')
+def test_dashed_strokes_hidden_layers_and_other_elements_are_named_or_left_out(tmp_path):
+    document = _write(tmp_path, '<g id="a"><circle cx="20" cy="20" r="8" stroke="red" stroke-dasharray="2 1"/>'
+                                '<text>hi</text></g><g id="b"><rect width="10" height="10" fill="none"/></g>')
     found, unread = outlines(document.static_tree(["a"], 0.0), SIZE)
     assert [outline.key for outline in found] == [(0, 0)]
-    assert unread == ["<circle> at (0, 0) (its stroke)", "<text> at (0, 1)"]
+    assert unread == ["<circle> at (0, 0) (its dashed stroke)", "<text> at (0, 1)"]
     found, unread = outlines(document.static_tree(["b"], 0.0), SIZE)
     assert found == [] and unread == []
 
@@ -95,7 +95,25 @@ def test_odd_viewports_do_not_stop_it(tmp_path, view, aspect):
 
 
 def test_transform_lists_and_inherited_strokes(tmp_path):
-    document = _write(tmp_path, '<g transform="translate(10 0) scale(2)" stroke="red"><rect width="4" height="4"/></g>')
+    document = _write(tmp_path, '<g transform="translate(10 0) scale(2)" stroke="red" stroke-width="3">'
+                                '<rect width="4" height="4"/></g>')
     found, unread = outlines(document.static_tree(document.layer_names(), 0.0), SIZE)
     np.testing.assert_allclose(found[0].rings[0][:4], [(10, 0), (18, 0), (18, 8), (10, 8)])
-    assert unread == ["<rect> at (0, 0) (its stroke)"]
+    assert unread == [] and [outline.key for outline in found] == [(0, 0), (0, 0, -1)]
+    # the band 3 px wide, scaled by 2: 3 px either side of the square's edges x = 10 and 18
+    spans = sorted((ring[:, 0].min(), ring[:, 0].max()) for ring in found[1].rings)
+    np.testing.assert_allclose(spans, [(7, 21), (13, 15)], atol=0.05)
+
+
+def test_a_turning_stroked_ring_reads_omega_r(tmp_path):
+    document = _write(tmp_path, '<g id="ring"><circle cx="32" cy="32" r="20" fill="none" stroke="black" '
+                                'stroke-width="6"/><animateTransform attributeName="transform" type="rotate" '
+                                'from="0 32 32" to="360 32 32" dur="3s" repeatCount="indefinite"/></g>'
+                                '<g id="arc"><polyline points="10,50 30,60 50,50" fill="none" stroke="black" '
+                                'stroke-width="4"/><animateTransform attributeName="transform" type="rotate" '
+                                'from="0 32 32" to="360 32 32" dur="3s" repeatCount="indefinite"/></g>')
+    for layer in ("ring", "arc"):
+        elements, unread = document.moving_elements([layer], 4 / FPS, 5 / FPS, SIZE)
+        flow, owned = vector_flow(elements, (SIZE[1], SIZE[0]))
+        assert unread == [] and owned.sum() > 100
+        assert_turning(flow, owned, (32, 32), 360 / (3 * FPS))
