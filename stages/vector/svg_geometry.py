@@ -59,7 +59,8 @@ def _attribute(element: ElementTree.Element, name: str) -> str | None:
 
 
 def _number(element: ElementTree.Element, name: str, default: float = 0.0) -> float:
-    text = element.get(name)
+    """A geometry property in px: from ``style`` first (a CSS animation writes it there), else the attribute."""
+    text = _attribute(element, name)
     if text is None:
         return default
     try:
@@ -115,7 +116,7 @@ def _path_data(element: ElementTree.Element, *, stroked: bool = False) -> PathDa
         width, height = _number(element, "width"), _number(element, "height")
         if width <= 0 or height <= 0:
             return None
-        rx_text, ry_text = element.get("rx"), element.get("ry")
+        rx_text, ry_text = _attribute(element, "rx"), _attribute(element, "ry")
         rx = _number(element, "rx") if rx_text is not None else _number(element, "ry") if ry_text is not None else 0.0
         ry = _number(element, "ry") if ry_text is not None else rx
         rx, ry = min(rx, width / 2), min(ry, height / 2)

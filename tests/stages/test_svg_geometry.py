@@ -117,3 +117,12 @@ def test_a_turning_stroked_ring_reads_omega_r(tmp_path):
         flow, owned = vector_flow(elements, (SIZE[1], SIZE[0]))
         assert unread == [] and owned.sum() > 100
         assert_turning(flow, owned, (32, 32), 360 / (3 * FPS))
+
+
+def test_geometry_a_css_animation_sets_in_style_is_read_there(tmp_path):
+    document = _write(tmp_path, '<style>.grow { animation: grow 1s linear infinite } '
+                                '@keyframes grow { from { r: 4px } to { r: 16px } }</style>'
+                                '<circle class="grow" cx="32" cy="32" r="10"/>')
+    found, unread = outlines(document.static_tree(document.layer_names(), 0.25), SIZE)
+    radius = np.hypot(*(found[0].rings[0] - 32).T)
+    assert unread == [] and radius.max() == pytest.approx(7.0, abs=0.05)  # 4 + 12 · 0.25, not the attribute's 10
