@@ -11,6 +11,7 @@ outside the image are clamped to the nearest edge pixel.
 import math
 
 import numpy as np
+from scipy import ndimage
 
 from fluidymation.engine._jit import kernel
 
@@ -81,3 +82,16 @@ def sample_patch(source, frame, x, y, theta, *, patch_size=5):
     out = np.empty((patch_size, patch_size, source.shape[3]), dtype=np.float32)
     _sample_patch(source, int(frame), float(x), float(y), float(theta), patch_size // 2, out)
     return out
+
+
+def sample_back(values: np.ndarray, flow: np.ndarray, *, order: int = 1) -> np.ndarray:
+    """``values`` (H, W) or (H, W, C) sampled where each pixel's material came from, q − ``flow``(q) (the motion
+    that brought it there), bilinearly (``order`` 1) or at the nearest pixel (0), edges repeated; float64."""
+    height, width = flow.shape[:2]
+    ys, xs = np.mgrid[:height, :width].astype(np.float64)
+    came_from = [ys - flow[..., 1], xs - flow[..., 0]]
+    values = np.asarray(values, np.float64)
+    if values.ndim == 2:
+        return ndimage.map_coordinates(values, came_from, order=order, mode="nearest")
+    return np.stack([ndimage.map_coordinates(values[..., c], came_from, order=order, mode="nearest")
+                     for c in range(values.shape[2])], axis=-1)

@@ -12,6 +12,8 @@ from __future__ import annotations
 import numpy as np
 from scipy import ndimage
 
+from fluidymation.engine.sampling import sample_back
+
 
 def luminance(rgb: np.ndarray) -> np.ndarray:
     """Mean of the R, G and B channels, float64 (H, W)."""
@@ -149,16 +151,11 @@ def compensated_residual(before, after, displacement, mask_before, mask_after, *
     """How much the texture changes apart from the shape's motion: mean |after(q) − before(q − d(q))| (R, G, B
     averaged; ``before`` sampled bilinearly) over the pixels ``margin`` px inside ``mask_after`` whose origin
     q − d(q) lies ``margin`` px inside ``mask_before``; ``displacement`` (H, W, 2) is the shape's motion d into
-    the later frame. Near 0 when the paint
-    travels with the shape (``carry``)."""
-    height, width = mask_after.shape
-    ys, xs = np.mgrid[:height, :width].astype(np.float64)
-    origin_y, origin_x = ys - displacement[..., 1], xs - displacement[..., 0]
+    the later frame. Near 0 when the paint travels with the shape (``carry``)."""
     kept_before = ndimage.binary_erosion(inside(mask_before), iterations=margin)
-    came_from = ndimage.map_coordinates(kept_before.astype(np.float64), [origin_y, origin_x], order=0, cval=0.0) > 0
+    came_from = sample_back(kept_before, displacement, order=0) > 0
     region = ndimage.binary_erosion(inside(mask_after), iterations=margin) & came_from
-    moved = np.stack([ndimage.map_coordinates(np.asarray(before[..., c], np.float64), [origin_y, origin_x], order=1,
-                                              mode="nearest") for c in range(3)], axis=-1)
+    moved = sample_back(np.asarray(before)[..., :3], displacement)
     return float(change(moved, after)[region].mean()) if region.any() else float("nan")
 
 

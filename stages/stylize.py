@@ -35,6 +35,7 @@ from scipy import ndimage
 
 from fluidymation.engine.nnf import NNF
 from fluidymation.engine.random import counter_hash
+from fluidymation.engine.sampling import sample_back
 from fluidymation.engine.shiftnnf import shift_nnf, temporal_modulation, transport_nnf
 from fluidymation.engine.synthesis import SynthesisParams, TargetInputs, concatenate_prepared, synthesize_prepared
 from fluidymation.engine.synthesis import prepare_source as prepare_engine_source
@@ -460,23 +461,19 @@ def _carried(previous: _Previous, frame: guides.FrameGuides, before: guides.Fram
     """The previous frame's state moved along the target's motion into ``frame`` (``carry``; ``before`` is the
     previous frame's guides).
 
-    Its matches move by :func:`~fluidymation.engine.shiftnnf.transport_nnf`, the rest comes from the pixel each
-    point came from. The motion SHIFTNNF then follows in exemplar time is the target's motion relative to its
-    material, not the distance carried: how much farther from the edge each point got (the medium spreading;
-    none on a rigid part, and none where an edge closes in), counted from half a pixel, the resolution of the
-    distance fields (below it, their interpolation errors would add up frame after frame). It is given as the ext+ that makes that the
-    increment. The colour stays only where nothing moved (a moved colour is the vote's).
+    Its matches move by :func:`~fluidymation.engine.shiftnnf.transport_nnf`, the rest comes from where each point
+    came from. The motion SHIFTNNF then follows in exemplar time is the target's motion relative to its material,
+    not the distance carried: how much farther from the edge each point got (the medium spreading; none on a
+    rigid part, and none where an edge closes in), counted from half a pixel, the resolution of the distance
+    fields (below it, their interpolation errors would add up frame after frame). It is given as the ext+ that
+    makes that the increment. The colour stays only where nothing moved (a moved colour is the vote's).
     """
     flow = frame.flow
     nnf, origin = transport_nnf(previous.nnf, flow)
     known = origin >= 0
-    height, width = known.shape
-    ys, xs = np.mgrid[:height, :width].astype(np.float32)
-    came_from = [ys - flow[..., 1], xs - flow[..., 0]]
 
-    def moved(values):  # sampled where each point came from
-        return np.where(known, ndimage.map_coordinates(values, came_from, order=1, mode="nearest"),
-                        np.float32(0.0)).astype(np.float32)
+    def moved(values):
+        return np.where(known, sample_back(values, flow), 0.0).astype(np.float32)
 
     spread = frame.dist - moved(before.dist)
     spread = np.where(spread > _DISTANCE_RESOLUTION, spread, 0.0)

@@ -58,6 +58,16 @@ def spreading_wash(*, size: int, frames: int, seed: int, start_radius: float, gr
     return rgb, mask
 
 
+def turn_flow(size: int, degrees: float, centre: float | None = None) -> np.ndarray:
+    """(size, size, 2) float32: the motion that brought each pixel's material there in a turn by ``degrees``
+    (clockwise on screen) about (``centre``, ``centre``), pixel centres at integers; default the image centre."""
+    angle, centre = np.radians(degrees), (size - 1) / 2 if centre is None else centre
+    yy, xx = np.mgrid[:size, :size].astype(np.float64)
+    back_x = centre + np.cos(angle) * (xx - centre) + np.sin(angle) * (yy - centre)
+    back_y = centre - np.sin(angle) * (xx - centre) + np.cos(angle) * (yy - centre)
+    return np.stack([xx - back_x, yy - back_y], axis=-1).astype(np.float32)
+
+
 def gear_points(centre: tuple[float, float], inner: float, outer: float, teeth: int = 8) -> np.ndarray:
     """(4·teeth, 2) vertices of a gear: ``teeth`` square teeth from radius ``inner`` to ``outer``."""
     k = np.arange(4 * teeth)

@@ -341,6 +341,7 @@ class _Walk:
     def __init__(self):
         self.elements: list[MovingElement] = []
         self.unread: list[str] = []
+        self._indices: dict[int, dict] = {}  # per composition walked (its layers list): layer index by ``ind``
 
     def group(self, items, matrices, frames: _Frames, where: str, taint: str | None = None) -> list[_Ring]:
         """Walk a shape group's ``items`` (top first); returns its paths for the fills below it.
@@ -449,7 +450,9 @@ class _Walk:
                 raise _Unread("an auto-oriented layer")
             if layer.get("ty") in _NOT_SHAPE_LAYERS:
                 raise _Unread(_NOT_SHAPE_LAYERS[layer["ty"]])
-            own = [_chain(layers, index, frame) for frame in frames.pair()]
+            by_ind = self._indices.setdefault(id(layers), {
+                other.get("ind"): i for i, other in enumerate(layers) if isinstance(other, dict) and "ind" in other})
+            own = [_chain(layers, by_ind, index, frame) for frame in frames.pair()]
             if own[1] is None or not _opaque(layer.get("ks"), frames.now):
                 return
             if own[0] is None:
@@ -520,10 +523,7 @@ def _masks(layer: dict, matrix: np.ndarray, frame: float) -> tuple[Clip, ...]:
         if mode not in _MASK_MODES:
             raise _Unread(f"masksProperties[{index}] of mode {mode!r}")
         path, _ = _keyframed(mask.get("pt"), frame, _path)
-        outline = _placed(_segments(path, True), matrix)
-        element = _element([_Ring(outline, outline)], False)
-        if element is None:
-            raise _Unread(f"masksProperties[{index}] out of range")
+        element = _region(_placed(_segments(path, True), matrix), f"masksProperties[{index}]")
         parts.append(ClipPart((element,), _MASK_MODES[mode], bool(mask.get("inv"))))
     return (Clip(tuple(parts)),) if parts else ()
 
@@ -536,11 +536,15 @@ def _box(width: float, height: float) -> np.ndarray:
 
 def _bounds_clip(width: float, height: float, matrix: np.ndarray) -> Clip:
     """:func:`_box` placed by ``matrix``, as a clip."""
-    rectangle = _placed(_box(width, height), matrix)
-    element = _element([_Ring(rectangle, rectangle)], False)
+    return Clip((ClipPart((_region(_placed(_box(width, height), matrix), "bounds"),)),))
+
+
+def _region(outline: np.ndarray, what: str) -> MovingElement:
+    """A closed outline (cubic segments in output px) as an element whose coverage a clip takes."""
+    element = _element([_Ring(outline, outline)], False)
     if element is None:
-        raise _Unread("bounds out of range")
-    return Clip((ClipPart((element,)),))
+        raise _Unread(f"{what} out of range")
+    return element
 
 
 def _remapped(layer: dict, frame: float, rate: float) -> float:
@@ -551,9 +555,9 @@ def _remapped(layer: dict, frame: float, rate: float) -> float:
     return (frame - _first(layer.get("st"), 0.0)) / stretch
 
 
-def _chain(layers: list, index: int, frame: float) -> np.ndarray | None:
-    """Layer ``index``'s matrix at ``frame`` through its parents (``parent`` names a layer's ``ind``)."""
-    by_ind = {layer.get("ind"): i for i, layer in enumerate(layers) if isinstance(layer, dict) and "ind" in layer}
+def _chain(layers: list, by_ind: dict, index: int, frame: float) -> np.ndarray | None:
+    """Layer ``index``'s matrix at ``frame`` through its parents (``parent`` names a layer's ``ind``; ``by_ind``
+    maps each ``ind`` to its layer's index)."""
     matrix, current = np.eye(3), index
     for _ in range(_MAX_NESTING):
         own = transform_matrix(layers[current].get("ks"), frame)

@@ -61,12 +61,14 @@ def _attribute(element: ElementTree.Element, name: str) -> str | None:
 def _number(element: ElementTree.Element, name: str, default: float = 0.0) -> float:
     """A geometry property in px: from ``style`` first (a CSS animation writes it there), else the attribute."""
     text = _attribute(element, name)
-    if text is None:
-        return default
+    return default if text is None else _px(text, f"<{local_name(element.tag)}> {name}='{text}'")
+
+
+def _px(text: str, what: str) -> float:
     try:
         return float(text.strip().removesuffix("px"))
     except ValueError:
-        raise ValueError(f"<{local_name(element.tag)}> {name}='{text}' is not a number in px") from None
+        raise ValueError(f"{what} is not a number in px") from None
 
 
 def _transform(element: ElementTree.Element) -> Matrix:
@@ -141,17 +143,10 @@ def _path_data(element: ElementTree.Element, *, stroked: bool = False) -> PathDa
     return PathData.parse(f"M{pairs}" if stroked and kind == "polyline" else f"M{pairs} Z")
 
 
-def _stroke_width(text: str) -> float:
-    try:
-        return float(text.strip().removesuffix("px"))
-    except ValueError:
-        raise ValueError(f"stroke-width '{text}' is not a number in px") from None
-
-
 def _stroke_outline(element: ElementTree.Element, key: tuple[int, ...], matrix: Matrix,
                     width_text: str) -> Outline | None:
     """The band the element's stroke paints (``stroke-width`` ``width_text``, scaled by ``matrix``), or None."""
-    width = _stroke_width(width_text)
+    width = _px(width_text, f"stroke-width '{width_text}'")
     data = _path_data(element, stroked=True)
     if data is None or width <= 0:
         return None

@@ -6,6 +6,7 @@ import pytest
 from fluidymation.engine.nnf import NNF
 from fluidymation.engine.shiftnnf import shift_nnf, temporal_modulation, transport_nnf
 from tests.naive import naive_shift_frames
+from tests.scenes import turn_flow
 
 
 def _single(frame, x, y, theta):
@@ -95,13 +96,10 @@ def _identity_field(height, width, frame=2):
 
 
 def test_transport_carries_matches_along_a_rigid_turn_and_turns_them_with_it():
-    size, omega, centre = 33, math.radians(3.0), 16.0
+    size, omega = 33, math.radians(3.0)
     ys, xs = np.mgrid[0:size, 0:size].astype(np.float64)
-    c, s = math.cos(-omega), math.sin(-omega)
-    # where each point was a frame ago: turned back by ω about the centre
-    before_x = centre + c * (xs - centre) - s * (ys - centre)
-    before_y = centre + s * (xs - centre) + c * (ys - centre)
-    flow = np.stack([xs - before_x, ys - before_y], axis=2).astype(np.float32)
+    flow = turn_flow(size, 3.0)  # about (16, 16)
+    before_x, before_y = xs - flow[..., 0], ys - flow[..., 1]  # where each point was a frame ago
     carried, origin = transport_nnf(_identity_field(size, size), flow)
     inner = slice(2, -2)
     np.testing.assert_allclose(carried.coords[inner, inner, 0], before_x[inner, inner], atol=1e-4)

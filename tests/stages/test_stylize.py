@@ -10,6 +10,7 @@ from scipy import ndimage
 from fluidymation.errors import StageError
 from fluidymation.quality import compensated_residual, gradient_profile, local_contrast
 from fluidymation.stages import exemplar_builtin, exemplar_store, guides, stylize
+from tests.scenes import turn_flow
 
 SIZE = 48
 GUIDES = guides.Params(blur_sigma=1.5, shape_radius=6, border_width=3, dist_time_sigma=0.5, flow_time_radius=1)
@@ -252,15 +253,6 @@ def test_no_seam_ring_where_the_border_and_interior_segments_meet(tmp_path):
     assert relative[5] < 1.2  # band 5–6 px, just inside the split: measured 0.67 (1.61 before)
 
 
-def _turn(degrees):
-    """The displacement (SIZE, SIZE, 2) of a turn by ``degrees`` about the image centre (clockwise on screen)."""
-    angle, centre = np.radians(degrees), SIZE / 2 - 0.5
-    yy, xx = np.mgrid[:SIZE, :SIZE].astype(np.float64)
-    back_x = centre + np.cos(angle) * (xx - centre) + np.sin(angle) * (yy - centre)
-    back_y = centre - np.sin(angle) * (xx - centre) + np.cos(angle) * (yy - centre)
-    return np.stack([xx - back_x, yy - back_y], axis=-1).astype(np.float32)
-
-
 def _residuals(frames, masks, displacement):
     return np.mean([compensated_residual(frames[j - 1].rgba, frames[j].rgba, displacement(j), masks(j - 1),
                                          masks(j)) for j in range(1, len(frames))])
@@ -272,7 +264,7 @@ def test_carry_moves_the_texture_with_the_shape(source, tmp_path, scene):
     change is under half that of independent frames (measured 0.19 and 0.02); without it the paint stays on the
     paper and changes more (0.65, 0.32)."""
     if scene == "turning disk":
-        masks, displacement, given = (lambda j: _disk(SIZE / 2, radius=18)), (lambda j: _turn(6.0)), _turn(6.0)
+        masks, displacement, given = (lambda j: _disk(SIZE / 2, radius=18)), (lambda j: turn_flow(SIZE, 6.0)), turn_flow(SIZE, 6.0)
     else:
         masks, displacement, given = moving, (lambda j: np.broadcast_to(np.float32([1, 0]), (SIZE, SIZE, 2))), None
     residual = {}
