@@ -5,7 +5,8 @@ they run in N spawned processes, each with ``cpu_count // N`` numba threads so t
 machine is not oversubscribed, and with this process's log level and progress format.
 ``dask://HOST:PORT`` submits them to an existing Dask distributed scheduler (extra
 ``fluidymation[distributed]``); its workers must see the same files (the output folder
-on a shared path). Results come back in the order of the jobs.
+on a shared path); a job running on a Dask worker submits its own jobs (a layer's frames)
+through that worker's client. Results come back in the order of the jobs.
 """
 
 from __future__ import annotations
@@ -42,7 +43,7 @@ def run_jobs(function: Callable, arguments: list[tuple], *, executor: str = LOCA
     """
     address = dask_address(executor)
     if address is not None:
-        return _on_dask(function, arguments, address)
+        return _from_dask_worker(function, arguments) if _inside_dask_worker() else _on_dask(function, arguments, address)
     if jobs <= 1 or len(arguments) <= 1:
         return [function(*args) for args in arguments]
     workers = min(jobs, len(arguments))
@@ -82,3 +83,22 @@ def _on_dask(function: Callable, arguments: list[tuple], address: str) -> list:
         log.debug("running %d jobs on the Dask cluster at %s", len(arguments), address)
         futures = [client.submit(function, *args, pure=False) for args in arguments]
         return client.gather(futures)
+
+
+def _inside_dask_worker() -> bool:
+    try:
+        from distributed import get_worker
+        get_worker()
+    except (ImportError, ValueError):
+        return False
+    return True
+
+
+def _from_dask_worker(function: Callable, arguments: list[tuple]) -> list:
+    """Jobs submitted by a job that runs on a Dask worker (a layer's frames): through the worker's client,
+    the worker giving up its thread while it waits so the cluster cannot deadlock."""
+    from distributed import worker_client
+
+    with worker_client() as client:
+        log.debug("running %d jobs from a Dask worker", len(arguments))
+        return client.gather([client.submit(function, *args, pure=False) for args in arguments])

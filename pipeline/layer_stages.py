@@ -13,6 +13,7 @@
 
 from __future__ import annotations
 
+import functools
 import logging
 import tempfile
 from dataclasses import dataclass
@@ -23,7 +24,8 @@ import numpy as np
 
 from fluidymation.errors import StageError
 from fluidymation.pipeline.cache import file_digest
-from fluidymation.pipeline.parameters import layer_guide_params
+from fluidymation.pipeline.executors import run_jobs
+from fluidymation.pipeline.parameters import layer_colorize, layer_guide_params
 from fluidymation.pipeline.progress import progress, reporter
 from fluidymation.pipeline.resolve import Plan, PlannedLayer
 from fluidymation.pipeline.resume import FrameStates
@@ -33,6 +35,8 @@ from fluidymation.stages.colour import parse_hex
 from fluidymation.stages.exemplar_store import StoredSource
 from fluidymation.stages.files import read_image, write_npy, write_png
 from fluidymation.stages.guide_views import VIEWS, write_guide_views
+from fluidymation.stages.keyframe_stylizer import painted_frame
+from fluidymation.stages.keyframes import read_keyframe
 from fluidymation.stages.stylizer import StylizeJob, Stylizer
 
 #: Version of the stylize stage's own work (files, resume); the stylizer's version is in its key too.
@@ -200,6 +204,8 @@ def _stylize_settings(work) -> StylizeSettings:
 
 
 def _stylize_inputs(work) -> dict:
+    if work.stylizer.uses_keyframes:
+        return {"keyframes": [[frame, file_digest(path)] for frame, path in work.layer.spec.keyframes]}
     return {"exemplar": work.exemplar_identity}
 
 
@@ -216,9 +222,11 @@ def _run_stylize(work, key: str) -> Done:
     if resume is not None:
         log.debug("stylize %s: resuming after frame %d (%d of %d frames were finished)",
                   layer.name, order[resume[0] - 1], resume[0], len(order))
-    files = stylize_layer(plan, layer, work.window, work.source, stylizer, work.stylize_params, work.guide_params,
+    source = None if stylizer.uses_keyframes else work.source
+    files = stylize_layer(plan, layer, work.window, source, stylizer, work.stylize_params, work.guide_params,
                           coverage_dir=work.out / "coverage" / layer.dirname, out_dir=out_dir, quiet=work.quiet,
-                          nnf=options.nnf, states=states, resume=resume, given_flow=layer_motion(work.out, layer))
+                          nnf=options.nnf, states=states, resume=resume, given_flow=layer_motion(work.out, layer),
+                          map_tasks=functools.partial(run_jobs, executor=options.executor, jobs=options.jobs))
     return Done(files, report={"resumed": 0 if resume is None else resume[0]})
 
 
@@ -227,25 +235,31 @@ def stylized_files(out_dir: Path, index: int, *, nnf=False) -> list[Path]:
     return [out_dir / f"{index:05d}.png"] + ([out_dir / "nnf" / f"{index:05d}.npy"] if nnf else [])
 
 
-def stylize_layer(plan: Plan, layer: PlannedLayer, window: range, source: StoredSource, stylizer: Stylizer, params,
-                  guide_params: guides.Params, *, coverage_dir: Path, out_dir: Path, quiet=False, nnf=False,
+def stylize_layer(plan: Plan, layer: PlannedLayer, window: range, source: StoredSource | None, stylizer: Stylizer,
+                  params, guide_params: guides.Params, *, coverage_dir: Path, out_dir: Path, quiet=False, nnf=False,
                   states: FrameStates | None = None, resume: tuple[int, Any] | None = None,
-                  given_flow=None) -> list[Path]:
+                  given_flow=None, map_tasks=None) -> list[Path]:
     """Stylize a layer's window of scene frames (coverage read from ``coverage_dir``) into ``out_dir``
-    (``given_flow``: the layer's motion from its geometry, :func:`layer_motion`).
+    (``given_flow``: the layer's motion from its geometry, :func:`layer_motion`; ``source``: its
+    exemplar, None for a stylizer that paints from keyframes).
 
     Returns the window's files. With ``states``, each frame's state is saved after its
     files; ``resume`` (from :meth:`FrameStates.resume_point`) continues after the frames
-    an interrupted run finished. The stylizer's scratch folder lives next to ``out_dir``.
+    an interrupted run finished, and the stylizer's work folder lives in the states' folder
+    (else next to ``out_dir``, like its scratch folder). ``map_tasks`` runs the stylizer's
+    independent tasks (default: here, one after the other).
     """
     out_dir.mkdir(parents=True, exist_ok=True)
     finished, after = (0, None) if resume is None else resume
+    keyframes = {frame - plan.start: path for frame, path in layer.spec.keyframes}
     with tempfile.TemporaryDirectory(prefix=".guides-", dir=out_dir.parent) as cache_dir, \
             progress(len(window), "stylize", layer=layer.name, quiet=quiet) as bar:
         bar.update(finished)
+        work_dir = str(states.folder / "work") if states is not None else str(Path(cache_dir) / "work")
         job = StylizeJob(masks=lambda j: read_coverage(coverage_dir, j), frame_count=plan.frame_count,
                          frames=(window.start - plan.start, window.stop - plan.start), source=source,
-                         guide_params=guide_params, cache_dir=cache_dir, resume=after, given_flow=given_flow)
+                         guide_params=guide_params, cache_dir=cache_dir, resume=after, given_flow=given_flow,
+                         keyframes=keyframes, work_dir=work_dir, map_tasks=map_tasks)
         for result in stylizer.stylize(job, params):
             png, *nnf_file = stylized_files(out_dir, result.index, nnf=nnf)
             write_png(png, result.rgba)
@@ -270,29 +284,41 @@ class ColorizeSettings:
 
 
 def _colorize_settings(work) -> ColorizeSettings:
-    return ColorizeSettings(work.layer.spec.colorize, work.layer.spec.color, work.frame_span)
+    return ColorizeSettings(layer_colorize(work.plan, work.layer), work.layer.spec.color, work.frame_span)
 
 
 def _run_colorize(work, key: str) -> Done:
-    params = layer_colorize_params(work.layer, work.record["fill"])
-    return Done(colorize_layer(work.plan, work.layer, work.window, work.source, params, work.out, quiet=work.quiet))
+    params = layer_colorize_params(work.plan, work.layer, work.record["fill"])
+    return Done(colorize_layer(work.plan, work.layer, work.window, work.paint, params, work.out, quiet=work.quiet))
 
 
-def layer_colorize_params(layer: PlannedLayer, fill_color: str | None) -> colorize.Params:
+def layer_colorize_params(plan: Plan, layer: PlannedLayer, fill_color: str | None) -> colorize.Params:
     """How a layer is colorized: ``colorize: layer`` (its colour or the vector fill), a ``#rrggbb``, or ``none``."""
-    mode = layer.spec.colorize
+    mode = layer_colorize(plan, layer)
     if mode == "none":
         return colorize.Params(mode="none")
     hex_color = mode if mode != "layer" else (layer.spec.color or fill_color or "#000000")
     return colorize.Params(mode="layer", color=tuple(float(c) for c in parse_hex(hex_color)))
 
 
-def colorize_layer(plan: Plan, layer: PlannedLayer, window: range, source: StoredSource,
-                   params: colorize.Params, out: Path, *, quiet=False) -> list[Path]:
+class KeyframePaint:
+    """A keyframe layer's paint as colorize reads an exemplar: ``rgb`` (its keyframes over white paper) and
+    ``segment`` (0 where painted, −1 on the paper)."""
+
+    def __init__(self, plan: Plan, layer: PlannedLayer, coverage_dir: Path):
+        painted = [read_keyframe(path, frame, read_coverage(coverage_dir, frame - plan.start))
+                   for frame, path in layer.spec.keyframes]
+        self.rgb = np.stack([painted_frame(rgba, rgba[..., 3])[..., :3] for rgba in painted])
+        self.segment = np.stack([np.where(rgba[..., 3] >= 0.5, 0, -1) for rgba in painted]).astype(np.int32)
+
+
+def colorize_layer(plan: Plan, layer: PlannedLayer, window: range, source, params: colorize.Params, out: Path, *,
+                   quiet=False) -> list[Path]:
     """Colorize the layer's stylized frames into ``out/layers/<layer>/``; return the files written.
 
-    The paper and paint density are statistics over every exemplar frame: its colour and
-    segments are read whole for them (16 bytes a pixel and frame), then released.
+    The paper and paint density are statistics over every frame of the layer's paint
+    (``source``: its exemplar, or its :class:`KeyframePaint`): its colour and segments are
+    read whole for them (16 bytes a pixel and frame), then released.
     """
     rgb, segment = source.rgb, source.segment
     paper = colorize.estimate_paper(rgb, segment)

@@ -81,6 +81,36 @@ def check_layer_params(plan: Plan, layer: PlannedLayer) -> None:
             close = difflib.get_close_matches(key, known, n=1)
             hint = f"; did you mean '{close[0]}'?" if close else f"; valid names: {', '.join(sorted(known))}"
             raise plan.scene.error(_param_path(layer, key), f"unknown parameter '{key}' of {owners}{hint}")
+    check_layer_keyframes(plan, layer)
+
+
+def _layer_path(plan: Plan, layer: PlannedLayer) -> KeyPath:
+    for index, spec in enumerate(plan.scene.layers or ()):
+        if spec.name == layer.name:
+            return ("layers", index)
+    return ("defaults",)
+
+
+def check_layer_keyframes(plan: Plan, layer: PlannedLayer) -> None:
+    """Raise SceneError when a stylizer that paints from keyframes has none, when keyframes are given to
+    one that does not, or when a keyframe's frame lies outside the scene's frames."""
+    stylizer = layer_stylizer(plan, layer)
+    where = _layer_path(plan, layer) + ("keyframes",)
+    if stylizer.uses_keyframes and not layer.spec.keyframes:
+        raise plan.scene.error(_layer_path(plan, layer), f"layer '{layer.name}': the stylizer '{stylizer.name}' "
+                               "paints from keyframes: give them as keyframes: {FRAME: IMAGE, ...}")
+    if layer.spec.keyframes and not stylizer.uses_keyframes:
+        raise plan.scene.error(where, f"layer '{layer.name}': the stylizer '{stylizer.name}' does not use "
+                               "keyframes (use stylizer: keyframes, or leave them out)")
+    for frame, path in layer.spec.keyframes:
+        if not plan.start <= frame < plan.end:
+            raise plan.scene.error(where + (frame,), f"{path}: keyframe {frame} is outside the scene's frames "
+                                   f"{plan.start}:{plan.end}")
+
+
+def layer_colorize(plan: Plan, layer: PlannedLayer) -> str:
+    """The layer's ``colorize:``, or its stylizer's default (``layer``; ``none`` for painted keyframes)."""
+    return layer.spec.colorize or layer_stylizer(plan, layer).default_colorize
 
 
 def layer_stylize_params(plan: Plan, layer: PlannedLayer, *, preview: bool = False):

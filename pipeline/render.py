@@ -31,7 +31,7 @@ from fluidymation.errors import SceneError
 from fluidymation.pipeline.cache import StageCache
 from fluidymation.pipeline.exemplars import layer_source, simulated_frame_count, stored_identity
 from fluidymation.pipeline.executors import LOCAL, run_jobs
-from fluidymation.pipeline.layer_stages import LAYER_STAGES
+from fluidymation.pipeline.layer_stages import LAYER_STAGES, KeyframePaint
 from fluidymation.pipeline.parameters import (
     check_layer_params, layer_guide_params, layer_stylize_params, layer_stylizer,
 )
@@ -64,7 +64,7 @@ class Options:
     report: bool = True  # write report.json (commands that only prepare inputs leave the film's report alone)
     force: bool = False  # redo every stage
     force_stages: tuple[str, ...] = ()  # redo these stages
-    jobs: int = 1  # layers rendered at once in local processes
+    jobs: int = 1  # local processes: the layers at once, or one layer's independent tasks (keyframe frames)
     executor: str = LOCAL  # or dask://HOST:PORT
 
 
@@ -116,6 +116,8 @@ def render(plan: Plan, options: Options) -> Path:
     run = _Run(plan, options)
     # workers elsewhere print to their own stderr: keep it quiet
     job_options = options if options.executor == LOCAL else dataclasses.replace(options, quiet=True)
+    if options.executor == LOCAL and len(chosen) > 1:
+        job_options = dataclasses.replace(job_options, jobs=1)  # the layers take the processes: their tasks run in them
     results = run_jobs(render_layer, [(plan, job_options, layer.name) for layer in chosen],
                        executor=options.executor, jobs=options.jobs)
     records = {}
@@ -231,6 +233,13 @@ class Work:
     def source(self) -> StoredSource:
         """The layer's exemplar with its guides (generated on first use)."""
         return load_layer_source(self.plan, self.layer, self.guide_params, self.quiet)
+
+    @cached_property
+    def paint(self):
+        """What colorize takes the paper and paint density from: the exemplar, or the painted keyframes."""
+        if self.stylizer.uses_keyframes:
+            return KeyframePaint(self.plan, self.layer, self.out / "coverage" / self.layer.dirname)
+        return self.source
 
     @property
     def record(self) -> dict:

@@ -29,7 +29,8 @@ _LAYER_NAME = re.compile(r"^[A-Za-z0-9_][A-Za-z0-9_.\- ]*$")
 
 _TOP_KEYS = ("version", "input", "animation", "theme", "fps", "frames", "size", "scale", "seed", "split", "output",
              "background", "exemplars", "defaults", "layers")
-_LAYER_KEYS = ("name", "select", "color", "exemplar", "stylizer", "colorize", "blend", "opacity", "flow", "params")
+_LAYER_KEYS = ("name", "select", "color", "exemplar", "stylizer", "colorize", "blend", "opacity", "flow", "params",
+               "keyframes")
 _DEFAULT_KEYS = ("exemplar", "stylizer", "colorize", "blend", "opacity", "flow", "params")
 #: Where a layer's motion comes from: the vector geometry, or the masks (paper appendix A).
 FLOW_SOURCES = ("vector", "masks")
@@ -66,7 +67,7 @@ class LayerSpec:
     color: str | None
     exemplar: str | None
     stylizer: str
-    colorize: str
+    colorize: str | None  # None: the stylizer's default (pipeline.parameters.layer_colorize)
     blend: str
     opacity: float
     params: dict = field(default_factory=dict)
@@ -74,6 +75,8 @@ class LayerSpec:
     param_paths: dict = field(default_factory=dict, compare=False)
     #: Where the layer's motion comes from: ``vector`` (the geometry; docs/guides.md) or ``masks``.
     flow: str = "vector"
+    #: Painted keyframes: (scene frame, image path) pairs in frame order (docs/keyframes.md).
+    keyframes: tuple[tuple[int, Path], ...] = ()
 
 
 @dataclass(frozen=True)
@@ -267,8 +270,8 @@ def _layer(check: Checker, where, allowed, exemplars: dict, base: LayerSpec | No
     if exemplar is not None and exemplars and exemplar not in exemplars:
         raise check.error(where + ("exemplar",), f"no exemplar called '{exemplar}' in the exemplars section "
                           f"(defined: {', '.join(exemplars)})")
-    colorize = check.text(where + ("colorize",), base.colorize if base else "layer")
-    if colorize not in ("layer", "none"):
+    colorize = check.text(where + ("colorize",), base.colorize if base else None)
+    if colorize not in ("layer", "none", None):
         colorize = check.color(where + ("colorize",))
     params = {key: _param_value(check, where + ("params", key), value)
               for key, value in check.mapping(where + ("params",), None).items()}
@@ -284,7 +287,29 @@ def _layer(check: Checker, where, allowed, exemplars: dict, base: LayerSpec | No
         params=(dict(base.params) if base else {}) | params,
         param_paths=(dict(base.param_paths) if base else {}) | {key: where + ("params", key) for key in params},
         flow=check.text(where + ("flow",), base.flow if base else "vector", choices=FLOW_SOURCES),
+        keyframes=_keyframes(check, where + ("keyframes",)) if "keyframes" in allowed else (),
     )
+
+
+def _keyframes(check: Checker, where) -> tuple[tuple[int, Path], ...]:
+    """``keyframes: {frame: image, ...}``: whole scene frame numbers to existing image files."""
+    data = check.value(where, None)
+    if data is None:
+        return ()
+    if not isinstance(data, dict) or not data:
+        raise check.error(where, "expected a mapping of frame numbers to images, e.g. {0: paint/000.png}")
+    pairs = []
+    for key in data:
+        frame = key if isinstance(key, int) and not isinstance(key, bool) else None
+        if frame is None and isinstance(key, str) and key.strip().lstrip("-").isdigit():
+            frame = int(key)
+        if frame is None:
+            raise check.error(where, f"keyframe {key!r}: the keys are whole frame numbers")
+        path = check.path(where + (key,))
+        if not path.is_file():
+            raise check.error(where + (key,), f"{path}: no such image")
+        pairs.append((frame, path))
+    return tuple(sorted(pairs))
 
 
 def _layers(check: Checker, exemplars: dict, defaults: LayerSpec) -> tuple[LayerSpec, ...] | None:

@@ -23,6 +23,7 @@ from __future__ import annotations
 import dataclasses
 from abc import ABC, abstractmethod
 from dataclasses import dataclass
+from pathlib import Path
 from typing import TYPE_CHECKING, Any, Callable, ClassVar, Iterator, NamedTuple, Protocol
 
 import numpy as np
@@ -62,7 +63,12 @@ class StylizeJob:
     a scratch folder for the length of the job; ``resume`` is None or what
     :meth:`Stylizer.resume_from` made of the state of the last finished frame;
     ``given_flow(j)``, when set, is frame j's motion read from the vector geometry (NaN where
-    unknown; docs/guides.md), for the guides in place of the masks' estimate.
+    unknown; docs/guides.md), for the guides in place of the masks' estimate;
+    ``keyframes`` maps frame indices to the layer's painted keyframe images (for a stylizer
+    that :attr:`~Stylizer.uses_keyframes`); ``work_dir`` is a folder that outlives an
+    interrupted run under the same stage key (for work finer than frames); ``map_tasks(f,
+    arguments)`` gives ``[f(*args) for args in arguments]``, maybe in other processes (``f``
+    module-level, its arguments picklable).
     """
 
     masks: Callable[[int], np.ndarray]
@@ -73,6 +79,9 @@ class StylizeJob:
     cache_dir: str
     resume: Any = None
     given_flow: Callable[[int], np.ndarray] | None = None
+    keyframes: dict[int, Path] = dataclasses.field(default_factory=dict)
+    work_dir: str | None = None
+    map_tasks: Callable[[Callable, list[tuple]], list] | None = None
 
 
 class Stylizer(ABC):
@@ -84,6 +93,10 @@ class Stylizer(ABC):
     defaults: ClassVar[Traversable | None] = None
     #: Whether the layer's guide parameters (``blur_sigma``, ``border_width`` …) mean anything to it.
     uses_guides: ClassVar[bool] = True
+    #: Whether it paints from the layer's ``keyframes:`` (then it needs them) rather than from an exemplar.
+    uses_keyframes: ClassVar[bool] = False
+    #: The layer's ``colorize:`` when the scene sets none.
+    default_colorize: ClassVar[str] = "layer"
     #: Whether its frames carry an NNF (``render --nnf``).
     writes_nnf: ClassVar[bool] = False
     #: The ablation study (``fluidymation ablate``): (label, parameters set to 0), the full energy first.

@@ -275,3 +275,23 @@ def naive_inside(rings, x, y, even_odd):
                 if crossing > x:
                     winding += 1 if y1 > y0 else -1
     return winding % 2 != 0 if even_odd else winding != 0
+
+
+def naive_scatter_vote(source, frames, coords, patch_size, weight, shape):
+    """Completeness vote: each matched source patch adds ``weight`` × its pixels (edges repeated) around its match."""
+    import numpy as np
+
+    total = np.zeros(shape + (source.shape[2],))
+    weights = np.zeros(shape)
+    for sy in range(source.shape[0]):
+        for sx in range(source.shape[1]):
+            if frames[sy, sx] < 0:
+                continue
+            tx, ty = int(np.floor(coords[sy, sx, 0] + 0.5)), int(np.floor(coords[sy, sx, 1] + 0.5))
+            for dx, dy in naive_window_offsets(patch_size):
+                if 0 <= tx + dx < shape[1] and 0 <= ty + dy < shape[0]:
+                    py = min(max(sy + dy, 0), source.shape[0] - 1)
+                    px = min(max(sx + dx, 0), source.shape[1] - 1)
+                    total[ty + dy, tx + dx] += weight * source[py, px]
+                    weights[ty + dy, tx + dx] += weight
+    return total, weights

@@ -53,8 +53,8 @@ def run(args) -> int:
         raise InputError(f"layer '{layer.name}': the stylizer '{stylizer.name}' defines no ablation study")
     guide_params = layer_guide_params(plan, layer)
     full = layer_stylize_params(plan, layer)
-    source = load_layer_source(plan, layer, guide_params, args.quiet)
-    paper = colorize.estimate_paper(source.rgb, source.segment)
+    source = None if stylizer.uses_keyframes else load_layer_source(plan, layer, guide_params, args.quiet)
+    paper = np.ones(3, np.float32) if source is None else colorize.estimate_paper(source.rgb, source.segment)
     panels, skipped = [], []
     for label, switched_off in stylizer.ablation:
         if switched_off and all(getattr(full, name) == 0 for name in switched_off):

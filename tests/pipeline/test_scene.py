@@ -26,7 +26,7 @@ def test_minimal_scene_gets_defaults_and_resolved_paths(tmp_path):
     assert scene.output.dir == (tmp_path / "out" / "scene").resolve()
     assert scene.output.video == "scene.mp4"
     assert scene.layers is None and scene.frames is None and scene.fps is None
-    assert scene.defaults.blend == "multiply" and scene.defaults.colorize == "layer"
+    assert scene.defaults.blend == "multiply" and scene.defaults.colorize is None  # the stylizer's default
 
 
 def test_full_scene(tmp_path):
