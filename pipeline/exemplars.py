@@ -144,7 +144,7 @@ def _store_with_guides(entry: Path, record: str, rgb, masks, flow, guide_params:
     entry.parent.mkdir(parents=True, exist_ok=True)
     staging = tempfile.mkdtemp(prefix=f".{entry.name}.", dir=entry.parent)
     try:
-        guides.compute_guides(lambda j: masks[j], len(masks), params=guide_params, cache_dir=staging,
+        guides.compute_guides(lambda j: masks[j], len(masks), params=guides.for_exemplar(guide_params), cache_dir=staging,
                               given_flow=None if flow is None else (lambda j: flow[j]))
         exemplar_store.store_colour(rgb, staging)
         with open(f"{staging}/done", "w") as handle:

@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import json
 import os
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 from typing import Any, Callable, NamedTuple, Sequence, Union
 
@@ -52,6 +52,8 @@ class Params:
     Attributes
     ----------
     blur_sigma : Gaussian blur of the masks before thresholding (thesis 4.1), px.
+    exemplar_blur_sigma : the same for an exemplar's masks (:meth:`for_exemplar`), px: they are the
+        paint's own edge, which a wide blur moves off the rim (docs/guides.md).
     threshold : blurred coverage at or above which a pixel is inside; below 0.5 so the
         mask includes a little paper.
     dist_time_sigma : Gaussian smoothing of the distance fields along time before the
@@ -66,6 +68,7 @@ class Params:
     """
 
     blur_sigma: float = 8.0
+    exemplar_blur_sigma: float = 2.0
     threshold: float = 0.4
     dist_time_sigma: float = 2.0
     flow_time_radius: int = 3
@@ -77,6 +80,7 @@ class Params:
     def __post_init__(self):
         checks = (
             ("blur_sigma", self.blur_sigma >= 0, "at least 0"),
+            ("exemplar_blur_sigma", self.exemplar_blur_sigma >= 0, "at least 0"),
             ("threshold", 0 < self.threshold < 1, "between 0 and 1 (exclusive)"),
             ("dist_time_sigma", self.dist_time_sigma >= 0, "at least 0"),
             ("flow_time_radius", int(self.flow_time_radius) == self.flow_time_radius and self.flow_time_radius >= 0,
@@ -90,6 +94,11 @@ class Params:
         for name, valid, wanted in checks:
             if not valid:
                 raise ParameterError(name, f"guides: parameter {name} must be {wanted}, got {getattr(self, name)!r}")
+
+
+def for_exemplar(params: Params) -> Params:
+    """The parameters of an exemplar's guides: ``params`` with its masks blurred by ``exemplar_blur_sigma``."""
+    return replace(params, blur_sigma=params.exemplar_blur_sigma)
 
 
 def map_frames(path: str | os.PathLike, start: int, stop: int, frame_shape: tuple, mode: str = "r") -> np.memmap:

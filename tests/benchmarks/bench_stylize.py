@@ -86,7 +86,7 @@ def exemplar_source(width, height, frames, guide_params, folder, *, stored=False
 
     params = resolve_params("watercolor-bloom", size=(width, height), frames=frames)
     exemplar = exemplar_builtin.make_builtin_exemplar(params, cache_dir=paths.exemplar_cache_dir())
-    cache = guides.compute_guides(lambda j: exemplar.mask[j], frames, params=guide_params, cache_dir=folder,
+    cache = guides.compute_guides(lambda j: exemplar.mask[j], frames, params=guides.for_exemplar(guide_params), cache_dir=folder,
                                   given_flow=lambda j: exemplar.flow[j])
     if not stored:
         return exemplar_store.in_memory(exemplar.rgb, cache)
