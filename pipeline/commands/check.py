@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from fluidymation.pipeline.parameters import layer_stylizer
+from fluidymation.pipeline.parameters import check_layer_params, layer_stylizer
 from fluidymation.pipeline.resolve import Plan, plan_scene
 from fluidymation.pipeline.scene import load_scene
 from fluidymation.stages.rasterize import ColorTally, Params, rasterize_frame
@@ -49,6 +49,9 @@ def describe(plan: Plan) -> str:
         found = tally.dominant() or "none (never visible in the sampled frames)"
         color = f"{layer.spec.color} (set in the scene; file: {found})" if layer.spec.color else found
         stylizer = layer_stylizer(plan, layer)
+        check_layer_params(plan, layer)
+        keyframes = f", keyframes at frames {', '.join(str(f) for f, _ in layer.spec.keyframes)}" \
+            if layer.spec.keyframes else ""
         lines.append(f"  {layer.name}: z={layer.z}, selects {', '.join(layer.vector_layers)}, colour {color}, "
-                     f"stylizer {stylizer.name} v{stylizer.version}")
+                     f"stylizer {stylizer.name} v{stylizer.version}{keyframes}")
     return "\n".join(lines)

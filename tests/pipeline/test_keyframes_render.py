@@ -139,3 +139,11 @@ def test_local_processes_and_a_dask_cluster_give_the_same_frames(rendered, paint
         address = cluster.scheduler_address.removeprefix("tcp://")
         assert main(["-q", "render", str(_scene(tmp_path / "dask")), "--executor", f"dask://{address}"]) == 0
     assert _stylized(tmp_path / "dask" / "out") == _stylized(rendered)
+
+
+def test_ablate_compares_the_keyframe_variants(painted, cli):
+    code, out, err = cli("ablate", _scene(painted), "--layer", "blob")
+    assert code == 0, err
+    variants = sorted(path.name for path in (painted / "out" / "ablate" / "blob").iterdir() if path.is_dir())
+    assert variants == ["no-neighbours", "no-velocity-modulation", "two-pass"]
+    assert (painted / "out" / "ablate" / "blob.mp4").is_file() and "wrote 3 versions" in out
