@@ -1,7 +1,7 @@
 """Regenerate the README's example videos and stills in docs/examples/ from the bundled examples.
 
 Run from the repository: ``.venv/bin/python docs/examples/make_examples.py [NAME ...]``
-(names: wave, blob, squiggle, ablate-blob, flow-gear; default all). Each example scene is
+(names: wave, blob, squiggle, puff, ablate-blob, flow-gear; default all). Each example scene is
 rendered with the installed ``fluidymation`` into its own ``examples/<name>/out/``; its video
 is copied here and five of its frames are laid side by side, 4 px apart, as ``<name>.jpg``.
 ``ablate-blob`` runs ``fluidymation ablate`` on the blob layer and keeps one frame of its
@@ -28,7 +28,8 @@ from fluidymation.stages.labels import label_strip
 REPOSITORY = Path(__file__).resolve().parents[2]
 HERE = Path(__file__).resolve().parent
 #: Which frames of each example's video make its still.
-STILL_FRAMES = {"wave": (0, 12, 24, 36, 47), "blob": (0, 12, 24, 36, 47), "squiggle": (2, 8, 14, 20, 23)}
+STILL_FRAMES = {"wave": (0, 12, 24, 36, 47), "blob": (0, 12, 24, 36, 47), "squiggle": (2, 8, 14, 20, 23),
+                "puff": (0, 6, 12, 18, 23)}
 ABLATION_FRAME = 24
 GAP = 4
 

@@ -9,7 +9,8 @@ growing 0.5 px a frame, painted keyframes every ``--key-every`` frames and at th
 (each painted independently: the texture shifted a little against the motion, as an
 artist's keyframes are); the flow is the true motion. Each run is a fresh process (its
 peak resident memory is its own) with the stylizer's defaults (configs/keyframes.yaml):
-one worker for every ``--frames`` count, then 2 workers (local processes) for the first.
+one worker for every ``--frames`` count, then for the first count 2 workers (local processes, a
+numba thread each) and one worker on one numba thread (what the frames' parallelism scales).
 Printed: wall time, s/frame, speed-up, peak RSS of the process and its workers, and the
 load average. The seed (Browning 2013, section 8) reports 30 min for a 400×400 sequence
 on a cluster node per frame (2.8 GHz 4-core), constant in the frame count.
@@ -120,16 +121,20 @@ def main() -> None:
     warm = [sys.executable, __file__, "--size", "64", "--key-every", "4", "--child", "5", "1"]
     subprocess.run(warm, check=True, capture_output=True)  # compile the kernels outside the timings
     results = []
-    for frames, jobs in [(count, 1) for count in args.frames] + [(args.frames[0], 2)]:
+    runs = [(count, 1, None) for count in args.frames] + [(args.frames[0], 2, None), (args.frames[0], 1, 1)]
+    for frames, jobs, threads in runs:
         command = [sys.executable, __file__, "--size", str(args.size), "--key-every", str(args.key_every),
                    "--child", str(frames), str(jobs)]
-        results.append(json.loads(subprocess.run(command, check=True, capture_output=True, text=True).stdout))
+        env = dict(os.environ, **({"NUMBA_NUM_THREADS": str(threads)} if threads else {}))
+        results.append(json.loads(subprocess.run(command, check=True, capture_output=True, text=True,
+                                                 env=env).stdout))
         row = results[-1]
-        print(f"  {row['frames']:3d} frames, {row['jobs']} worker(s): {row['seconds']:7.1f} s, "
+        what = f"{row['jobs']} worker(s)" + (f", {threads} numba thread" if threads else "")
+        print(f"  {row['frames']:3d} frames, {what}: {row['seconds']:7.1f} s, "
               f"{row['seconds'] / row['frames']:6.2f} s/frame, peak RSS {row['peak_mib']:6.0f} MiB", flush=True)
-    serial = next(row for row in results if row["jobs"] == 1 and row["frames"] == args.frames[0])
-    parallel = results[-1]
-    print(f"speed-up with 2 workers: {serial['seconds'] / parallel['seconds']:.2f}×; "
+    serial, parallel, one_thread = results[0], results[-2], results[-1]
+    print(f"speed-up with 2 workers: {serial['seconds'] / parallel['seconds']:.2f}× over one process with "
+          f"its numba threads, {one_thread['seconds'] / parallel['seconds']:.2f}× over one process on one thread; "
           f"load average {os.getloadavg()[0]:.2f}")
 
 
