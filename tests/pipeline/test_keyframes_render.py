@@ -147,3 +147,17 @@ def test_ablate_compares_the_keyframe_variants(painted, cli):
     variants = sorted(path.name for path in (painted / "out" / "ablate" / "blob").iterdir() if path.is_dir())
     assert variants == ["no-neighbours", "no-velocity-modulation", "two-pass"]
     assert (painted / "out" / "ablate" / "blob.mp4").is_file() and "wrote 3 versions" in out
+
+
+def test_colorize_a_colour_repaints_the_keyframe_paint_in_it(painted, tmp_path):
+    folder = tmp_path / "tinted"
+    folder.mkdir()
+    for name in ("k0.png", "k3.png"):
+        (folder / name).write_bytes((painted / name).read_bytes())
+    scene = _scene(folder)
+    scene.write_text(scene.read_text().replace("stylizer: keyframes,", 'stylizer: keyframes, colorize: "#1f7a3a",'))
+    assert main(["-q", "render", str(scene), "--until", "colorize"]) == 0
+    layer = iio.imread(folder / "out" / "layers" / "blob" / "00000.png").astype(np.float32) / 255
+    painted_pixels = layer[..., 3] > 0.5
+    red, green, blue = (layer[..., c][painted_pixels].mean() for c in range(3))
+    assert green > red and green > blue  # the keyframes' red-brown paint now in the layer's green
