@@ -114,16 +114,26 @@ def blockiness(frames, masks, *, periods=(2,), margin: int = 2) -> tuple[float, 
 
 
 def local_contrast(rgb: np.ndarray, region: np.ndarray, *, erosion: int = 3) -> float:
-    """Mean 5×5 standard deviation of the luminance inside ``region`` eroded by ``erosion`` px (wash-out)."""
+    """Mean 5×5 standard deviation of the luminance inside ``region`` eroded by ``erosion`` px (wash-out);
+    nan when nothing of the region is left."""
+    kept = ndimage.binary_erosion(inside(region), iterations=erosion)
+    if not kept.any():
+        return float("nan")
     lum = luminance(rgb)
     mean = ndimage.uniform_filter(lum, 5)
     spread = np.sqrt(np.maximum(ndimage.uniform_filter(lum * lum, 5) - mean * mean, 0))
-    return float(spread[ndimage.binary_erosion(inside(region), iterations=erosion)].mean())
+    return float(spread[kept].mean())
 
 
 def change(before: np.ndarray, after: np.ndarray) -> np.ndarray:
     """Per-pixel frame-to-frame change: |after − before| averaged over R, G and B, (H, W)."""
     return np.abs(after[..., :3].astype(np.float64) - before[..., :3]).mean(axis=-1)
+
+
+def ratio(numerator: float, denominator: float) -> float:
+    """numerator / denominator as numpy divides (inf over 0, nan for 0 / 0 or with a nan)."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return float(np.float64(numerator) / denominator)
 
 
 def pooled_mean(maps, regions, *, min_pixels: int = 1) -> float:
@@ -213,12 +223,15 @@ def texture_fidelity(frames, masks, exemplar_frames, exemplar_masks, *, size: in
     uniformly (with the fixed ``seed``) from all frames; each is compared with every
     exemplar patch centred in the exemplar's masks (exact nearest neighbour, brute force).
     The distance is the RMS colour difference over the patch's pixels and channels
-    (sRGB in [0, 1]), so it reads as a typical per-pixel error.
+    (sRGB in [0, 1]), so it reads as a typical per-pixel error. nan when no output patch
+    lies wholly inside the masks or the exemplar has no patch.
     """
     library = np.concatenate([patches(rgb, patch_centres(mask, size, whole=False), size)
                               for rgb, mask in zip(exemplar_frames, exemplar_masks)])
     centres = [patch_centres(mask, size) for mask in masks]
     where = np.concatenate([np.column_stack([np.full(len(c), t), c]) for t, c in enumerate(centres)])
+    if not len(where) or not len(library):
+        return float("nan")
     rng = np.random.default_rng(seed)
     chosen = where[np.sort(rng.choice(len(where), size=min(samples, len(where)), replace=False))]
     queries = np.concatenate([patches(frames[t], chosen[chosen[:, 0] == t, 1:], size) for t in range(len(frames))])

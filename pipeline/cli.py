@@ -18,7 +18,7 @@ from fluidymation import __version__
 from fluidymation.errors import FluidymationError
 from fluidymation.pipeline.progress import use_json_lines
 
-COMMANDS = ("check", "masks", "guides", "synth", "exemplar", "render", "ablate", "cache")
+COMMANDS = ("check", "masks", "guides", "synth", "exemplar", "render", "ablate", "compare", "cache")
 
 EXIT_USAGE = 2
 EXIT_INTERNAL = 1

@@ -2,9 +2,10 @@
 
 A layer names its exemplar with ``exemplar:`` (its own or the scene defaults'); the
 ``exemplars:`` section defines it: a built-in preset, or a recording (``video:`` a file,
-``images:`` a folder or pattern) with masks (``mask:`` an image sequence or ``auto``) and
-a flow estimated from the masks (``flow: masks``, the default) or from the frames
-(``flow: motion``). With no name the built-in ``watercolor-bloom`` with its default
+``images:`` a folder or pattern, ``image:`` one still painting) with masks (``mask:`` an
+image sequence or ``auto``) and a flow estimated from the masks (``flow: masks``, the
+default) or from the frames (``flow: motion``). A still painting may bring its colour-coded
+regions (``segments:``, :mod:`fluidymation.stages.regions`): its mask is then where they are. With no name the built-in ``watercolor-bloom`` with its default
 parameters is used. Generated built-in exemplars and all exemplar guides are kept under
 :func:`fluidymation.pipeline.paths.cache_dir`; an exemplar's colour is stored beside its
 guides, so a stage reads from disk only the exemplar frames it needs
@@ -26,10 +27,12 @@ from fluidymation.pipeline import paths
 from fluidymation.pipeline.presets import resolve_params
 from fluidymation.pipeline.resolve import Plan, PlannedLayer
 from fluidymation.stages import exemplar_builtin, exemplar_store, exemplar_user, guides
+from fluidymation.stages.files import read_image
+from fluidymation.stages.regions import read_regions
 
 DEFAULT_BUILTIN = "watercolor-bloom"
 _BUILTIN_OPTIONS = ("kind", "builtin", "seed", "size", "frames", "color", "wetness")
-_USER_OPTIONS = ("kind", "path", "mask", "flow", "scale", "step", "frames", "reverse", "seed")
+_USER_OPTIONS = ("kind", "path", "mask", "flow", "scale", "step", "frames", "reverse", "seed", "segments")
 
 
 def exemplar_spec(plan: Plan, layer: PlannedLayer) -> tuple[str, dict]:
@@ -81,7 +84,8 @@ def user_params(plan: Plan, name: str, spec: dict) -> exemplar_user.Params:
     if isinstance(frames, int):
         frames = (0, frames)
     try:
-        return exemplar_user.Params(source=str(spec["path"]), mask=str(spec.get("mask", "auto")),
+        mask = "full" if "segments" in spec else str(spec.get("mask", "auto"))  # the regions are the mask
+        return exemplar_user.Params(source=str(spec["path"]), mask=mask,
                                     scale=spec.get("scale", 1.0), step=int(step), start=frames[0], end=frames[1],
                                     reverse=spec.get("reverse", False))
     except StageError as exc:
@@ -118,6 +122,7 @@ def layer_source(plan: Plan, layer: PlannedLayer, guide_params: guides.Params, *
     record = _stored_record(plan, layer, guide_params)
     entry = paths.exemplar_guides_cache_dir() / stored_identity(plan, layer, guide_params)
     if not (entry / "done").is_file():
+        found = None
         if spec["kind"] == "builtin":
             exemplar = exemplar_builtin.make_builtin_exemplar(builtin_params(plan, name, spec),
                                                               cache_dir=paths.exemplar_cache_dir(), progress=progress)
@@ -126,27 +131,35 @@ def layer_source(plan: Plan, layer: PlannedLayer, guide_params: guides.Params, *
             recording = exemplar_user.load_user_exemplar(user_params(plan, name, spec))
             rgb, masks = recording.rgb, recording.mask
             flow = exemplar_user.motion_flow(rgb, seed=spec.get("seed", 0)) if spec.get("flow") == "motion" else None
-        _store_with_guides(entry, record, rgb, masks, flow, guide_params)
+            if "segments" in spec:
+                painted = read_image(spec["path"], channels=3).shape[:2]
+                found = read_regions(spec["segments"], painted).resized(rgb.shape[1:3])
+                masks = (found.labels >= 0)[None]
+        _store_with_guides(entry, record, rgb, masks, flow, guide_params, regions=found)
     return exemplar_store.StoredSource(entry)
 
 
 def _recording_identity(params: exemplar_user.Params, spec: dict) -> str:
-    """A cache key for a recording: its reading options, flow choice and the files' sizes and times."""
-    stamps = [(str(p), p.stat().st_size, p.stat().st_mtime_ns) for p in exemplar_user.image_sequence(params.source)]
+    """A cache key for a recording: its reading options, flow choice and the files' (and segments') sizes and times."""
+    files = exemplar_user.image_sequence(params.source) + ([Path(spec["segments"])] if "segments" in spec else [])
+    stamps = [(str(p), p.stat().st_size, p.stat().st_mtime_ns) for p in files]
     record = json.dumps({"params": dataclasses.asdict(params), "flow": spec.get("flow", "masks"),
                          "seed": spec.get("seed", 0), "files": stamps}, sort_keys=True, default=str)
     return "recording-" + hashlib.sha256(record.encode()).hexdigest()[:16]
 
 
-def _store_with_guides(entry: Path, record: str, rgb, masks, flow, guide_params: guides.Params) -> None:
-    """Compute the exemplar's guides (from ``flow``, or the masks) and store them with its colour in ``entry``,
-    marked done with ``record``."""
+def _store_with_guides(entry: Path, record: str, rgb, masks, flow, guide_params: guides.Params, *,
+                       regions=None) -> None:
+    """Compute the exemplar's guides (from ``flow``, or the masks) and store them with its colour (and its
+    ``regions``, when it has some) in ``entry``, marked done with ``record``."""
     entry.parent.mkdir(parents=True, exist_ok=True)
     staging = tempfile.mkdtemp(prefix=f".{entry.name}.", dir=entry.parent)
     try:
         guides.compute_guides(lambda j: masks[j], len(masks), params=guides.for_exemplar(guide_params), cache_dir=staging,
                               given_flow=None if flow is None else (lambda j: flow[j]))
         exemplar_store.store_colour(rgb, staging)
+        if regions is not None:
+            exemplar_store.store_regions(regions, staging)
         with open(f"{staging}/done", "w") as handle:
             handle.write(record)
         try:

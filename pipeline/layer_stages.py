@@ -74,8 +74,9 @@ def _run_masks(work, key: str) -> Done:
     plan, layer, out = work.plan, work.layer, work.out
     with progress(plan.frame_count, "masks", layer=layer.name, quiet=work.quiet) as bar:
         record = rasterize_layer(plan, layer, range(plan.start, plan.end), out / "masks" / layer.dirname,
-                                 coverage_dir=out / "coverage" / layer.dirname, bar=bar)
-    files = [out / folder / layer.dirname / f"{k:05d}.png" for folder in ("masks", "coverage")
+                                 coverage_dir=out / "coverage" / layer.dirname,
+                                 colour_dir=out / "colour" / layer.dirname, bar=bar)
+    files = [out / folder / layer.dirname / f"{k:05d}.png" for folder in ("masks", "coverage", "colour")
              for k in range(plan.frame_count)]
     if layer.flow == "vector":
         with progress(plan.frame_count, "motion", layer=layer.name, quiet=work.quiet) as bar:
@@ -125,8 +126,9 @@ def input_digest(plan: Plan) -> list[str]:
 
 
 def rasterize_layer(plan: Plan, layer: PlannedLayer, frames: range, masks_dir: Path, *,
-                    coverage_dir: Path | None = None, bar=None) -> dict:
-    """Write the layer's masks (0/255; and soft coverage into ``coverage_dir``) for scene ``frames``.
+                    coverage_dir: Path | None = None, colour_dir: Path | None = None, bar=None) -> dict:
+    """Write the layer's masks (0/255; soft coverage into ``coverage_dir``, its straight colour into
+    ``colour_dir``) for scene ``frames``.
 
     Files are numbered from the scene's start. ``bar`` is advanced once per frame.
     Returns the layer's summary record: selection, colour (the scene's, else the fill), the
@@ -140,6 +142,8 @@ def rasterize_layer(plan: Plan, layer: PlannedLayer, frames: range, masks_dir: P
         write_png(masks_dir / name, image.mask.astype(np.uint8) * 255)
         if coverage_dir is not None:
             write_png(coverage_dir / name, image.coverage)
+        if colour_dir is not None:
+            write_png(colour_dir / name, image.straight_rgb)
         tally.add(image.rgba)
         areas.append(int(image.mask.sum()))
         if bar is not None:
@@ -152,6 +156,16 @@ def rasterize_layer(plan: Plan, layer: PlannedLayer, frames: range, masks_dir: P
 def read_coverage(coverage_dir: Path, index: int) -> np.ndarray:
     """Frame ``index``'s soft coverage, (H, W) float32, as written by :func:`rasterize_layer`."""
     return read_image(coverage_dir / f"{index:05d}.png", channels=1)[:, :, 0]
+
+
+def layer_colour_dir(coverage_dir: Path) -> Path:
+    """Where the masks stage wrote the straight colour of the layer whose coverage is in ``coverage_dir``."""
+    return coverage_dir.parent.parent / "colour" / coverage_dir.name
+
+
+def read_colour(colour_dir: Path, index: int) -> np.ndarray:
+    """Frame ``index``'s straight colour, (H, W, 3) float32, as written by :func:`rasterize_layer`."""
+    return read_image(colour_dir / f"{index:05d}.png", channels=3)
 
 
 # --- guides ----------------------------------------------------------------------------------------------------
@@ -189,18 +203,22 @@ def write_layer_guides(plan: Plan, layer: PlannedLayer, window: range, coverage,
 
 @dataclass(frozen=True)
 class StylizeSettings:
-    """The stylizer (name, version, parameters) and the frames it paints; ``nnf``: also write each frame's NNF."""
+    """The stylizer (name, version, parameters), the frames it paints, ``nnf``: also write each frame's NNF, and
+    the layer's ``segments`` and ``segment_map`` (its regions)."""
 
     stylizer: str
     stylizer_version: int
     params: Any
     frames: tuple[int, int]
     nnf: bool
+    segments: str
+    segment_map: tuple
 
 
 def _stylize_settings(work) -> StylizeSettings:
-    stylizer = work.stylizer
-    return StylizeSettings(stylizer.name, stylizer.version, work.stylize_params, work.frame_span, work.options.nnf)
+    stylizer, spec = work.stylizer, work.layer.spec
+    return StylizeSettings(stylizer.name, stylizer.version, work.stylize_params, work.frame_span, work.options.nnf,
+                           spec.segments, spec.segment_map)
 
 
 def _stylize_inputs(work) -> dict:
@@ -256,10 +274,13 @@ def stylize_layer(plan: Plan, layer: PlannedLayer, window: range, source: Stored
             progress(len(window), "stylize", layer=layer.name, quiet=quiet) as bar:
         bar.update(finished)
         work_dir = str(states.folder / "work") if states is not None else str(Path(cache_dir) / "work")
+        colour_dir = layer_colour_dir(coverage_dir)
         job = StylizeJob(masks=lambda j: read_coverage(coverage_dir, j), frame_count=plan.frame_count,
                          frames=(window.start - plan.start, window.stop - plan.start), source=source,
                          guide_params=guide_params, cache_dir=cache_dir, resume=after, given_flow=given_flow,
-                         keyframes=keyframes, work_dir=work_dir, map_tasks=map_tasks)
+                         keyframes=keyframes, work_dir=work_dir, map_tasks=map_tasks,
+                         colours=lambda j: read_colour(colour_dir, j), segments=layer.spec.segments,
+                         segment_map=layer.spec.segment_map, layer=layer.name)
         for result in stylizer.stylize(job, params):
             png, *nnf_file = stylized_files(out_dir, result.index, nnf=nnf)
             write_png(png, result.rgba)

@@ -117,14 +117,24 @@ def layer_stylize_params(plan: Plan, layer: PlannedLayer, *, preview: bool = Fal
     """The layer's stylizer parameters: its defaults file < scene seed < layer params < ``preview:`` (with ``preview``)."""
     check_layer_params(plan, layer)
     stylizer = layer_stylizer(plan, layer)
-    names = stylizer.parameter_names()
-    values = _config_values(stylizer, "params")
-    if "seed" in names:
-        values["seed"] = (plan.scene.seed, (plan.scene.doc, ("seed",)))
-    values |= _scene_values(plan, layer, names)
+    values = _default_values(plan, stylizer) | _scene_values(plan, layer, stylizer.parameter_names())
     if preview:
         values |= _config_values(stylizer, "preview")
     return build_params(stylizer.Params, values, fallback=_fallback(plan, layer))
+
+
+def scene_default_params(plan: Plan, stylizer: Stylizer):
+    """The stylizer's parameters for a layer it does not paint in the scene: its defaults file < the scene's
+    seed (``fluidymation compare``)."""
+    return build_params(stylizer.Params, _default_values(plan, stylizer), fallback=None)
+
+
+def _default_values(plan: Plan, stylizer: Stylizer) -> dict[str, tuple]:
+    """The stylizer's defaults file, with the scene's seed when its ``Params`` has a ``seed``."""
+    values = _config_values(stylizer, "params")
+    if "seed" in stylizer.parameter_names():
+        values["seed"] = (plan.scene.seed, (plan.scene.doc, ("seed",)))
+    return values
 
 
 def layer_guide_params(plan: Plan, layer: PlannedLayer) -> guides.Params:

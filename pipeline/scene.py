@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from fluidymation.errors import SceneError
-from fluidymation.pipeline.schema import Checker
+from fluidymation.pipeline.schema import HEX_COLOR, Checker
 from fluidymation.pipeline.stylizers import stylizer_names
 from fluidymation.pipeline.yaml_lines import KeyPath, LocatedYaml, load_yaml
 
@@ -24,17 +24,19 @@ MAX_FPS = 1000.0
 BACKGROUND_TYPES = ("synthesized", "solid", "image")
 BLEND_MODES = ("multiply", "over")
 PREVIEW_FORMATS = ("gif", "webp")
-EXEMPLAR_KINDS = ("builtin", "video", "images")
+EXEMPLAR_KINDS = ("builtin", "video", "images", "image")
 _LAYER_NAME = re.compile(r"^[A-Za-z0-9_][A-Za-z0-9_.\- ]*$")
 
 _TOP_KEYS = ("version", "input", "animation", "theme", "fps", "frames", "size", "scale", "seed", "split", "output",
              "background", "exemplars", "defaults", "layers")
 _LAYER_KEYS = ("name", "select", "color", "exemplar", "stylizer", "colorize", "blend", "opacity", "flow", "params",
-               "keyframes")
-_DEFAULT_KEYS = ("exemplar", "stylizer", "colorize", "blend", "opacity", "flow", "params")
+               "keyframes", "segments", "segment_map")
+_DEFAULT_KEYS = ("exemplar", "stylizer", "colorize", "blend", "opacity", "flow", "params", "segments")
+#: Where a layer's regions come from for the ``still`` stylizer: its fill colours, or its mask as one region.
+SEGMENT_SOURCES = ("by-color", "mask")
 #: Where a layer's motion comes from: the vector geometry, or the masks (paper appendix A).
 FLOW_SOURCES = ("vector", "masks")
-_EXEMPLAR_KEYS = ("builtin", "video", "images", "mask", "flow", "scale", "step", "frames", "reverse",
+_EXEMPLAR_KEYS = ("builtin", "video", "images", "image", "segments", "mask", "flow", "scale", "step", "frames", "reverse",
                   "seed", "size", "color", "wetness")
 
 
@@ -77,6 +79,10 @@ class LayerSpec:
     flow: str = "vector"
     #: Painted keyframes: (scene frame, image path) pairs in frame order (docs/keyframes.md).
     keyframes: tuple[tuple[int, Path], ...] = ()
+    #: The layer's regions for region-matching stylizers: ``by-color`` (its fill colours) or ``mask`` (docs/still.md).
+    segments: str = "by-color"
+    #: Layer fill colour → exemplar region colour, both '#rrggbb', overriding the nearest-colour match.
+    segment_map: tuple[tuple[str, str], ...] = ()
 
 
 @dataclass(frozen=True)
@@ -205,13 +211,20 @@ def _exemplars(check: Checker) -> dict:
         check.mapping(where, _EXEMPLAR_KEYS, required=True)
         kinds = [kind for kind in EXEMPLAR_KINDS if check.has(where + (kind,))]
         if len(kinds) != 1:
-            raise check.error(where, "give exactly one of builtin (a preset name), video (a file) "
-                              "or images (a folder or pattern of frames)")
+            raise check.error(where, "give exactly one of builtin (a preset name), video (a file), "
+                              "images (a folder or pattern of frames) or image (a still painting)")
         spec = {"kind": kinds[0]}
         if kinds[0] == "builtin":
             spec["builtin"] = check.text(where + ("builtin",))
         else:
             spec["path"] = check.path(where + (kinds[0],))
+        if check.has(where + ("segments",)):
+            if kinds[0] != "image":
+                raise check.error(where + ("segments",), "only a still image exemplar (image:) takes segments")
+            if check.has(where + ("mask",)):
+                raise check.error(where + ("mask",), "an exemplar with segments takes its mask from them; "
+                                  "leave out mask")
+            spec["segments"] = check.path(where + ("segments",))
         result[name] = spec | _exemplar_options(check, where)
     return result
 
@@ -231,7 +244,8 @@ def _exemplar_options(check: Checker, where) -> dict:
     if check.has(where + ("wetness",)):
         options["wetness"] = check.number(where + ("wetness",), minimum=0, maximum=1)
     if check.has(where + ("mask",)):
-        options["mask"] = "auto" if check.value(where + ("mask",)) == "auto" else check.path(where + ("mask",))
+        value = check.value(where + ("mask",))
+        options["mask"] = value if value in ("auto", "full") else check.path(where + ("mask",))
     if check.has(where + ("flow",)):
         options["flow"] = check.text(where + ("flow",), choices=("masks", "motion", "exact"))
     if check.has(where + ("frames",)):
@@ -288,7 +302,19 @@ def _layer(check: Checker, where, allowed, exemplars: dict, base: LayerSpec | No
         param_paths=(dict(base.param_paths) if base else {}) | {key: where + ("params", key) for key in params},
         flow=check.text(where + ("flow",), base.flow if base else "vector", choices=FLOW_SOURCES),
         keyframes=_keyframes(check, where + ("keyframes",)) if "keyframes" in allowed else (),
+        segments=check.text(where + ("segments",), base.segments if base else "by-color", choices=SEGMENT_SOURCES),
+        segment_map=_segment_map(check, where + ("segment_map",)) if "segment_map" in allowed else (),
     )
+
+
+def _segment_map(check: Checker, where) -> tuple[tuple[str, str], ...]:
+    """``segment_map: {"#layer-fill": "#exemplar-region", ...}``: colours to colours."""
+    pairs = []
+    for key in check.mapping(where, None):
+        if not isinstance(key, str) or not HEX_COLOR.match(key):
+            raise check.error(where, f"{key!r}: the keys are the layer's fill colours as \"#rrggbb\"")
+        pairs.append((key.lower(), check.color(where + (key,))))
+    return tuple(pairs)
 
 
 def _keyframes(check: Checker, where) -> tuple[tuple[int, Path], ...]:

@@ -19,6 +19,7 @@ import numpy as np
 from fluidymation.engine import distance
 from fluidymation.errors import StageError
 from fluidymation.stages import guides
+from fluidymation.stages.regions import Regions
 
 
 @dataclass(frozen=True)
@@ -94,6 +95,7 @@ class StoredSource:
     """
 
     COLOUR_FILE = "rgb.f32"
+    REGIONS_FILE = "regions.npz"
 
     def __init__(self, directory):
         self.cache = guides.GuideCache.open(directory)
@@ -133,10 +135,24 @@ class StoredSource:
         return self.colour(0, self.frame_count)
 
     @property
+    def regions(self) -> Regions | None:
+        """A still exemplar's colour regions (its ``segments:`` image), or None when it has none."""
+        path = self.cache.directory / self.REGIONS_FILE
+        if not path.is_file():
+            return None
+        with np.load(path) as stored:
+            return Regions(stored["labels"], stored["colours"])
+
+    @property
     def segment(self) -> np.ndarray:
         """Every frame's segment labels, (T, Hs, Ws) int32 (as :class:`Source`)."""
         return np.stack([distance.segments(self.cache.read("dist", index), border_width=self.cache.border_width)
                          .astype(np.int32) - 1 for index in range(self.frame_count)])
+
+
+def store_regions(regions: Regions, directory) -> None:
+    """Write a still exemplar's colour regions beside its guides (read back by :attr:`StoredSource.regions`)."""
+    np.savez(Path(directory) / StoredSource.REGIONS_FILE, labels=regions.labels, colours=regions.colours)
 
 
 def store_colour(rgb: np.ndarray, directory) -> None:

@@ -1,8 +1,10 @@
 """User exemplars: a recording of a real medium (video file or image sequence) and its masks.
 
-Frames come from a video (decoded by imageio-ffmpeg) or an image sequence (a folder, a
-glob pattern such as ``frames/*.png`` or a printf pattern such as ``frames/%04d.png``).
-Masks come from an image sequence with one image per source frame, or ``"auto"``:
+Frames come from a video (decoded by imageio-ffmpeg), an image sequence (a folder, a
+glob pattern such as ``frames/*.png`` or a printf pattern such as ``frames/%04d.png``)
+or one still image (a recording of one frame).
+Masks come from an image sequence with one image per source frame, ``"full"`` (paint
+everywhere: a painting that fills its canvas), or ``"auto"``:
 the paper colour is the median of a band along the frame's borders, pixels farther
 from it than a threshold are paint, small specks are removed and holes filled, and the
 result is blurred and thresholded (thesis 4.1) so its outline is smooth. The source
@@ -97,6 +99,9 @@ def load_user_exemplar(params: Params) -> UserExemplar:
     if params.mask == "auto":
         masks = np.stack([_auto_mask(frame, band, params) for frame in rgb])
         origin = f"{params.source} (mask: auto)"
+    elif params.mask == "full":
+        masks = np.ones(rgb.shape[:3], bool)
+        origin = params.source
     else:
         masks = _read_masks(params.mask, len(frames), shape[:2], params.source)[indices]
         origin = params.mask
@@ -135,9 +140,11 @@ def _read_frames(spec: str) -> list[np.ndarray]:
     path = Path(spec)
     if path.is_file() and path.suffix.lower() in VIDEO_SUFFIXES:
         return _read_video(path)
+    if path.is_file() and path.suffix.lower() in IMAGE_SUFFIXES:
+        return [read_image(path, channels=3)]  # a still: a recording of one frame
     if path.is_file():
-        raise InputError(f"{spec}: not a video ({', '.join(VIDEO_SUFFIXES)}) nor an image sequence "
-                         "(a folder, a glob like frames/*.png, or a pattern like frames/%04d.png)")
+        raise InputError(f"{spec}: not a video ({', '.join(VIDEO_SUFFIXES)}), an image ({', '.join(IMAGE_SUFFIXES)}) "
+                         "nor an image sequence (a folder, a glob like frames/*.png, or a pattern like frames/%04d.png)")
     files = image_sequence(spec)
     if not files:
         raise InputError(f"{spec}: no such video and no images match it as a sequence "

@@ -1,4 +1,4 @@
-"""Text captions for comparison videos (Pillow's built-in bitmap font)."""
+"""Text captions for comparison videos and contact sheets (Pillow's built-in font)."""
 
 from __future__ import annotations
 
@@ -17,3 +17,17 @@ def label_strip(labels: list[str], *, width: int) -> list[np.ndarray]:
         ImageDraw.Draw(image).text((2, 1), label, fill=(20, 20, 20), font=font)
         strips.append(np.asarray(image, np.float32) / np.float32(255.0))
     return strips
+
+
+def wrapped_caption(parts: list[str], *, width: int, separator: str = " · ") -> np.ndarray:
+    """``parts`` joined by ``separator`` and wrapped between parts to fit ``width``: (n · CAPTION_HEIGHT, width, 3)
+    float32, one :func:`label_strip` line each (a part wider than the width is clipped)."""
+    font = ImageFont.load_default()
+    lines = [parts[0]]
+    for part in parts[1:]:
+        joined = lines[-1] + separator + part
+        if font.getlength(joined) + 4 <= width:  # 2 px margin on each side
+            lines[-1] = joined
+        else:
+            lines.append(part)
+    return np.concatenate(label_strip(lines, width=width))

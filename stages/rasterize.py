@@ -15,7 +15,7 @@ import numpy as np
 from fluidymation.stages.vector import Renderer, VectorDocument
 
 NAME = "rasterize"
-VERSION = 1
+VERSION = 2  # 2: the layer's straight colour is written beside its coverage
 MASK_THRESHOLD = 0.5
 
 
@@ -35,6 +35,13 @@ class LayerRaster:
     @property
     def mask(self) -> np.ndarray:
         return self.coverage >= MASK_THRESHOLD
+
+    @property
+    def straight_rgb(self) -> np.ndarray:
+        """(H, W, 3) float32 in [0, 1]: the layer's own colour where it shows (premultiplication undone), 0 elsewhere."""
+        alpha = self.rgba[:, :, 3:4].astype(np.float32)
+        rgb = self.rgba[:, :, :3].astype(np.float32) / np.maximum(alpha, 1.0)
+        return np.clip(rgb, 0.0, 1.0)
 
 
 def rasterize_frame(renderer: Renderer, document: VectorDocument, vector_layers: tuple[str, ...], frame: int,

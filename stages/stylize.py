@@ -45,7 +45,7 @@ from fluidymation.stages import guides
 from fluidymation.stages.exemplar_store import Source, StoredSource, border_clamped, concatenate
 
 NAME = "stylize"
-VERSION = 6  # 6: flow-aligned rotations lay the source flow along the target's (were mirrored)
+VERSION = 7  # 7: an exemplar with one segment is matched by the whole target (was unmatched, black)
 
 #: Target guide channels, in order; the source compares shape, ext+, ext− and its colour (as S_temp).
 _GUIDES = ("shape", "edge", "ext_plus", "ext_minus", "temp_r", "temp_g", "temp_b")
@@ -508,6 +508,8 @@ def _synthesize(sequence: _Sequence, k: int, frame: guides.FrameGuides, inside: 
     params, target, held = sequence.params, sequence.target, sequence.window
     exemplar = held.frames
     segment = np.where(inside, np.maximum(frame.segments.astype(np.int32) - 1, 0), -1).astype(np.int32)
+    if len(held.labels) == 1:  # an exemplar painted to its frame's edge has no border: match its one segment
+        segment = np.where(inside, held.labels[0], -1).astype(np.int32)
     temp = np.zeros((target.height, target.width, 3), np.float32)
     modulation = np.zeros((1, target.height, target.width), np.float32)
     initial = keep_margin = None
@@ -606,6 +608,7 @@ class _SlidingWindow:
                 prepared.append(self.prepare(frames[-1]))
         self.frames, self.prepared = concatenate(frames), concatenate_prepared(prepared)
         self.start, self.stop = start, stop
+        self.labels = np.unique(self.frames.segment[self.frames.segment >= 0])
 
     def inside(self, nnf: NNF) -> NNF:
         """``nnf`` (exemplar frame numbers) in window frame numbers; matches outside the window

@@ -68,7 +68,9 @@ class StylizeJob:
     that :attr:`~Stylizer.uses_keyframes`); ``work_dir`` is a folder that outlives an
     interrupted run under the same stage key (for work finer than frames); ``map_tasks(f,
     arguments)`` gives ``[f(*args) for args in arguments]``, maybe in other processes (``f``
-    module-level, its arguments picklable).
+    module-level, its arguments picklable); ``colours(j)`` gives frame j's straight colour of the
+    layer's own fills, (H, W, 3) float32; ``segments`` and ``segment_map`` are the layer's keys of
+    those names (its regions, for a stylizer matching regions); ``layer`` its name, for messages.
     """
 
     masks: Callable[[int], np.ndarray]
@@ -82,6 +84,10 @@ class StylizeJob:
     keyframes: dict[int, Path] = dataclasses.field(default_factory=dict)
     work_dir: str | None = None
     map_tasks: Callable[[Callable, list[tuple]], list] | None = None
+    colours: Callable[[int], np.ndarray] | None = None
+    segments: str = "by-color"
+    segment_map: tuple[tuple[str, str], ...] = ()
+    layer: str = ""
 
 
 class Stylizer(ABC):

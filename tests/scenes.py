@@ -128,3 +128,28 @@ def turning_gear_lottie(folder: Path) -> Path:
     path = folder / "gear.json"
     path.write_text(json.dumps({"v": "5.7.0", "fr": 24, "ip": 0, "op": 72, "w": 64, "h": 64, "layers": [layer]}))
     return path
+
+
+def two_region_painting(size: int = 64):
+    """A still painting of two regions with distinct textures: blue stripes left of a wavy line, green dots
+    right of it. Returns rgb (size, size, 3) float32 and the region labels (size, size) int32 (0 blue, 1 green)."""
+    rng = np.random.default_rng(0)
+    yy, xx = np.mgrid[:size, :size]
+    labels = np.where(xx < size / 2 + 6 * np.sin(yy / 6), 0, 1).astype(np.int32)
+    stripes = 0.5 + 0.4 * np.sin(xx * 0.9 + rng.normal(0, 0.3, (size, size)))
+    dots = (rng.random((size, size)) < 0.15).astype(np.float32)
+    rgb = np.where((labels == 0)[..., None], np.stack([0.2 * stripes, 0.3 * stripes, 0.9 * stripes], -1),
+                   np.stack([0.3 + 0.5 * dots, 0.8 - 0.3 * dots, 0.2 + 0 * dots], -1)).astype(np.float32)
+    return rgb, labels
+
+
+def map_svg(size: int = 48) -> str:
+    """A still two-colour map (group ``map``: water #334ccc left, land #409940 right) and a ``boat`` (#e0c070)
+    sailing right 12 px over 1 s, in SMIL."""
+    half = size // 2
+    return (f'<svg xmlns="http://www.w3.org/2000/svg" width="{size}" height="{size}" viewBox="0 0 {size} {size}">\n'
+            f'  <g id="map"><rect x="2" y="2" width="{half - 2}" height="{size - 4}" fill="#334ccc"/>\n'
+            f'    <rect x="{half}" y="2" width="{half - 2}" height="{size - 4}" fill="#409940"/></g>\n'
+            f'  <g id="boat" fill="#e0c070"><circle cx="12" cy="{half}" r="7">\n'
+            '    <animate attributeName="cx" from="12" to="24" begin="0s" dur="1s" fill="freeze"/></circle></g>\n'
+            '</svg>\n')

@@ -61,12 +61,6 @@ CURVE_BANDS = 20
 SHEET_QUALITY = 90
 PAPER = np.array(exemplar_builtin.PAPER_COLOUR, np.float32)
 
-def ratio(numerator: float, denominator: float) -> float:
-    """numerator / denominator as numpy divides (inf over 0, nan for 0 / 0 or with a nan)."""
-    with np.errstate(divide="ignore", invalid="ignore"):
-        return float(np.float64(numerator) / denominator)
-
-
 class Canvas:
     """The square the scenes are drawn on: described on a 128-px canvas, drawn ``scale`` times larger.
 
@@ -201,7 +195,8 @@ def exemplar_figures(rgb, mask, flow) -> dict:
     return {"profile": peak, "profile_band": band, "profile_curve": profile_curve(profile, counts),
             "blockiness": quality.blockiness(rgb, mask),
             "contrast_last_first": contrast[-1] / contrast[0], "contrast": float(np.mean(contrast)),
-            "still": still, "band_still": ratio(quality.pooled_mean(changes, bands, min_pixels=MIN_REGION), still)}
+            "still": still,
+            "band_still": quality.ratio(quality.pooled_mean(changes, bands, min_pixels=MIN_REGION), still)}
 
 
 def load_exemplar(medium: str, size: int, workdir: Path, guide_params: guides.Params) -> Exemplar:
@@ -246,7 +241,7 @@ def measure(scene: Scene, exemplar: Exemplar, params: stylize.Params, guide_para
         "blockiness": quality.blockiness(output, masks),
         "contrast_last_first": contrast[-1] / contrast[0], "contrast": float(np.mean(contrast)),
         "still": still_change, "still_w_temp0": independent,
-        "band_still": ratio(quality.pooled_mean(changes, bands, min_pixels=MIN_REGION), still_change),
+        "band_still": quality.ratio(quality.pooled_mean(changes, bands, min_pixels=MIN_REGION), still_change),
         "iou": min(quality.iou(frame[..., 3], mask) for frame, mask in zip(output, masks)),
         "fidelity": quality.texture_fidelity(output, masks, exemplar.rgb, exemplar.mask),
     }
@@ -263,9 +258,9 @@ def verdicts(figures: dict, reference: dict, baseline: float | None) -> dict:
         "profile": check(figures["profile"], lambda v: v <= 1.1 * reference["profile"]),
         "blocks": check(figures["blockiness"][0], lambda v: v <= 1.05),
         "C last/1st": check(figures["contrast_last_first"], lambda v: v >= 0.9),
-        "C/ex": check(ratio(figures["contrast"], reference["contrast"]), lambda v: 0.85 <= v <= 1.15),
-        "still/wt0": check(ratio(figures["still"], figures["still_w_temp0"]), lambda v: v <= 0.3),
-        "still/ex": check(ratio(figures["still"], reference["still"]), lambda v: v <= 2.0),
+        "C/ex": check(quality.ratio(figures["contrast"], reference["contrast"]), lambda v: 0.85 <= v <= 1.15),
+        "still/wt0": check(quality.ratio(figures["still"], figures["still_w_temp0"]), lambda v: v <= 0.3),
+        "still/ex": check(quality.ratio(figures["still"], reference["still"]), lambda v: v <= 2.0),
         "band/still": check(figures["band_still"], lambda v: v >= 2.0),
         "IoU": check(figures["iou"], lambda v: v >= 0.98),
         "fidelity": None if baseline is None else check(figures["fidelity"],
@@ -298,10 +293,10 @@ def scene_row(name: str, figures: dict, reference: dict, baseline: float | None)
             _cell(f"{_number(figures['profile'])}@{figures['profile_band']}", verdict["profile"]),
             _cell(f"{figures['blockiness'][0]:.3f}", verdict["blocks"]),
             _cell(_number(figures["contrast_last_first"]), verdict["C last/1st"]),
-            _cell(_number(ratio(figures["contrast"], reference["contrast"])), verdict["C/ex"]),
+            _cell(_number(quality.ratio(figures["contrast"], reference["contrast"])), verdict["C/ex"]),
             _number(1e3 * figures["still"]) + f" / {_number(1e3 * figures['still_w_temp0'])}",
-            _cell(_number(ratio(figures["still"], figures["still_w_temp0"])), verdict["still/wt0"]),
-            _cell(_number(ratio(figures["still"], reference["still"])), verdict["still/ex"]),
+            _cell(_number(quality.ratio(figures["still"], figures["still_w_temp0"])), verdict["still/wt0"]),
+            _cell(_number(quality.ratio(figures["still"], reference["still"])), verdict["still/ex"]),
             _cell(_number(figures["band_still"]), verdict["band/still"]),
             _cell(_number(figures["iou"], 3), verdict["IoU"]),
             _cell(fidelity, verdict["fidelity"])]

@@ -42,7 +42,7 @@ def test_two_jobs_render_the_layers_in_two_processes_with_the_same_output(here, 
     caplog.set_level(logging.DEBUG, logger="fluidymation.pipeline.executors")
     out = _render(tmp_path / "jobs", "--jobs", "2")
     assert "running 2 jobs in 2 processes" in caplog.text
-    assert _products(out) == here and len(here) == 2 * 3 * 4 + 1  # masks, coverage, stylized, layers; film
+    assert _products(out) == here and len(here) == 2 * 3 * 5 + 1  # masks, coverage, colour, stylized, layers; film
     report = json.loads((out / "report.json").read_text())
     assert [(entry["stage"], entry["layer"]) for entry in report["stages"]][:6] == [
         (stage, layer) for layer in ("blob", "drop") for stage in ("masks", "stylize", "colorize")]

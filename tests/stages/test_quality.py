@@ -78,6 +78,7 @@ def test_local_contrast_of_a_flat_and_a_checkered_region():
     checker = np.indices((20, 20)).sum(axis=0) % 2
     # a 5×5 window holds 13 of one value and 12 of the other: std = sqrt(p (1 − p))
     assert quality.local_contrast(_grey(checker), region) == pytest.approx(np.sqrt(13 * 12) / 25)
+    assert np.isnan(quality.local_contrast(_grey(checker), _disk(20, 3)))  # nothing left after the erosion
 
 
 def test_still_region_is_where_nothing_moves():
@@ -141,6 +142,7 @@ def test_texture_fidelity_is_zero_for_exemplar_patches_and_grows_with_noise():
     assert 0.02 < noisy < 0.051  # the nearest patch is at most the noise's RMS away
     again = quality.texture_fidelity([shuffled + noise], [inner], [exemplar], [mask])
     assert again == noisy
+    assert np.isnan(quality.texture_fidelity([shuffled], [_disk(48, 2)], [exemplar], [mask]))  # no whole patch
 
 
 def test_compensated_residual_is_zero_for_texture_moved_with_the_shape():

@@ -1,0 +1,64 @@
+"""The ``still`` stylizer: flat-coloured layers painted from one still exemplar and its regions (seed 002).
+
+Parameters are :class:`fluidymation.stages.still.Params`, their defaults ``configs/still.yaml``;
+the method is :mod:`fluidymation.stages.still` (docs/still.md). The layer's regions come from
+its fill colours (``segments: by-color``) or its mask (``segments: mask``), matched to the
+exemplar's regions by nearest colour or the layer's ``segment_map:``. The state kept per
+finished frame is its NNF and colour, so a resumed run carries the texture on as before.
+"""
+
+from __future__ import annotations
+
+import logging
+from importlib import resources
+from pathlib import Path
+
+import numpy as np
+
+from fluidymation.engine.nnf import NNF
+from fluidymation.stages import guides, still
+from fluidymation.stages.stylizer import StylizeJob, Stylizer
+
+log = logging.getLogger(__name__)
+
+
+class StillStylizer(Stylizer):
+    """One painting, matched region to region, carried along the layer's motion (seed 002 and docs/still.md)."""
+
+    name = "still"
+    version = still.VERSION
+    Params = still.Params
+    defaults = resources.files("fluidymation.configs").joinpath("still.yaml")
+    default_colorize = "none"
+    writes_nnf = True
+    ablation = (("full", ()), ("no uniformity", ("uniformity",)), ("no guide", ("w_guide",)))
+
+    def stylize(self, job: StylizeJob, params: still.Params):
+        painting = still.painting_from(job.source, params.exemplar_frame)
+        regions = still.layer_regions(((job.colours(j), job.masks(j)) for j in range(job.frame_count)),
+                                      painting.regions, mode=job.segments, segment_map=job.segment_map,
+                                      where=f"layer '{job.layer}'")
+        flow = None
+        if params.follow_motion and job.frame_count > 1:
+            motion = guides.compute_guides(job.masks, job.frame_count, params=job.guide_params,
+                                           cache_dir=Path(job.cache_dir) / "guides", given_flow=job.given_flow)
+            flow = lambda j: motion.read("flow", j)  # noqa: E731
+        first, stop = job.frames
+        previous = None
+        if job.resume is not None:
+            index, nnf, rgb = job.resume
+            coverage = job.masks(index)
+            previous = still.StillFrame(index, np.concatenate([rgb, coverage[..., None]], axis=2), nnf,
+                                        regions.of(job.colours(index), coverage))
+            first = index + 1
+        counts = still.Counts()
+        yield from still.stylize_frames(job.masks, job.colours, (first, stop), still.StillSynthesis(painting, params),
+                                        regions, flow=flow, previous=previous, counts=counts)
+        log.info("still %s: %d frames synthesized, %d carried along the motion, %d reused unchanged",
+                 job.layer, counts.synthesized, counts.followed, counts.reused)
+
+    def frame_state(self, frame: still.StillFrame) -> dict[str, np.ndarray]:
+        return {"frame": frame.nnf.frame, "coords": frame.nnf.coords, "rgb": frame.rgba[..., :3]}
+
+    def resume_from(self, index: int, state: dict[str, np.ndarray]):
+        return index, NNF(state["frame"], state["coords"]), state["rgb"]
