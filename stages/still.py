@@ -117,6 +117,11 @@ class Painting:
     regions: Regions
 
 
+def resumed(index: int, nnf: NNF, rgb: np.ndarray, coverage: np.ndarray, labels: np.ndarray) -> StillFrame:
+    """Finished frame ``index`` rebuilt from its saved NNF and colour and its coverage and labels (for resume)."""
+    return StillFrame(index, np.concatenate([rgb, coverage[..., None]], axis=2).astype(np.float32), nnf, labels)
+
+
 def painting_from(source, frame: int) -> Painting:
     """Frame ``frame`` of a stored exemplar with its regions; an exemplar without ``segments:`` is one region,
     its mask, coloured by its mean paint."""

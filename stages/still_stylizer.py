@@ -48,8 +48,7 @@ class StillStylizer(Stylizer):
         if job.resume is not None:
             index, nnf, rgb = job.resume
             coverage = job.masks(index)
-            previous = still.StillFrame(index, np.concatenate([rgb, coverage[..., None]], axis=2), nnf,
-                                        regions.of(job.colours(index), coverage))
+            previous = still.resumed(index, nnf, rgb, coverage, regions.of(job.colours(index), coverage))
             first = index + 1
         counts = still.Counts()
         yield from still.stylize_frames(job.masks, job.colours, (first, stop), still.StillSynthesis(painting, params),

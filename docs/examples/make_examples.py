@@ -1,14 +1,16 @@
 """Regenerate the README's example videos and stills in docs/examples/ from the bundled examples.
 
 Run from the repository: ``.venv/bin/python docs/examples/make_examples.py [NAME ...]``
-(names: wave, blob, squiggle, puff, ablate-blob, flow-gear; default all). Each example scene is
+(names: wave, blob, squiggle, puff, map, ablate-blob, flow-gear, compare-boat; default all). Each example scene is
 rendered with the installed ``fluidymation`` into its own ``examples/<name>/out/``; its video
 is copied here and five of its frames are laid side by side, 4 px apart, as ``<name>.jpg``.
 ``ablate-blob`` runs ``fluidymation ablate`` on the blob layer and keeps one frame of its
 side-by-side video. ``flow-gear`` renders ``examples/gear`` three times, with its motion from
 the masks (``flow: masks``), from the geometry (``flow: vector``, the default) and from the
 geometry with the stylizer's ``carry: true``, and sets the videos side by side, labelled
-(``flow-gear.mp4``; frame 24 as ``flow-gear.jpg``).
+(``flow-gear.mp4``; frame 24 as ``flow-gear.jpg``). ``compare-boat`` runs ``fluidymation compare``
+on the boat of ``examples/map`` with the still, lazyfluids and fluidymation stylizers and keeps
+its contact sheet (``compare-boat.jpg``).
 """
 
 from __future__ import annotations
@@ -29,7 +31,7 @@ REPOSITORY = Path(__file__).resolve().parents[2]
 HERE = Path(__file__).resolve().parent
 #: Which frames of each example's video make its still.
 STILL_FRAMES = {"wave": (0, 12, 24, 36, 47), "blob": (0, 12, 24, 36, 47), "squiggle": (2, 8, 14, 20, 23),
-                "puff": (0, 6, 12, 18, 23)}
+                "puff": (0, 6, 12, 18, 23), "map": (0, 6, 12, 18, 23)}
 ABLATION_FRAME = 24
 GAP = 4
 
@@ -82,17 +84,24 @@ def make_flow_comparison() -> None:
     iio.imwrite(HERE / "flow-gear.jpg", frames[ABLATION_FRAME], quality=90)
 
 
+def make_stylizer_comparison() -> None:
+    fluidymation("compare", "examples/map/scene.yaml", "--layer", "boat", "--stylizers", "still,lazyfluids,fluidymation")
+    sheet = iio.imread(REPOSITORY / "examples" / "map" / "out" / "compare" / "boat.png")
+    iio.imwrite(HERE / "compare-boat.jpg", sheet[..., :3], quality=90)
+
+
+SPECIAL = {"ablate-blob": make_ablation, "flow-gear": make_flow_comparison, "compare-boat": make_stylizer_comparison}
+
+
 def main() -> None:
-    names = sys.argv[1:] or [*STILL_FRAMES, "ablate-blob", "flow-gear"]
+    names = sys.argv[1:] or [*STILL_FRAMES, *SPECIAL]
     for name in names:
-        if name == "ablate-blob":
-            make_ablation()
-        elif name == "flow-gear":
-            make_flow_comparison()
+        if name in SPECIAL:
+            SPECIAL[name]()
         elif name in STILL_FRAMES:
             make_example(name)
         else:
-            sys.exit(f"unknown example {name!r}: choose from {', '.join([*STILL_FRAMES, 'ablate-blob', 'flow-gear'])}")
+            sys.exit(f"unknown example {name!r}: choose from {', '.join([*STILL_FRAMES, *SPECIAL])}")
 
 
 if __name__ == "__main__":

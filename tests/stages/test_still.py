@@ -9,6 +9,7 @@ from fluidymation.errors import InputError
 from fluidymation.stages import regions as regions_module
 from fluidymation.stages import still
 from fluidymation.stages.regions import Regions
+from fluidymation.stages.still_stylizer import StillStylizer
 
 from tests.scenes import two_region_painting
 
@@ -136,3 +137,19 @@ def test_read_regions_takes_flat_colours_and_refuses_a_size_mismatch(tmp_path):
     assert set(np.unique(found.labels[:, 10])) <= {0, 1}
     with pytest.raises(InputError, match="seg.png: the segments image is 30x20, the painting 40x20"):
         regions_module.read_regions(tmp_path / "seg.png", (20, 40))
+
+
+def test_a_run_resumed_from_a_finished_frames_state_continues_with_the_same_frames():
+    frames = [target(2.0 * j) for j in range(4)]
+    flow = np.zeros(frames[0][1].shape + (2,), np.float32)
+    flow[..., 0] = 2.0
+    whole, art = run(frames, flow=lambda j: flow)
+    stylizer = StillStylizer()
+    index, nnf, rgb = stylizer.resume_from(1, stylizer.frame_state(whole[1]))
+    previous = still.resumed(index, nnf, rgb, frames[1][1], whole[1].labels)
+    layer = still.layer_regions(frames, art.regions, mode="by-color", where="test")
+    rest = list(still.stylize_frames(lambda j: frames[j][1], lambda j: frames[j][0], (2, 4),
+                                     still.StillSynthesis(art, still.Params()), layer, flow=lambda j: flow,
+                                     previous=previous))
+    assert [frame.index for frame in rest] == [2, 3]
+    assert all(np.array_equal(a.rgba, b.rgba) for a, b in zip(rest, whole[2:]))
