@@ -18,7 +18,19 @@ from fluidymation import __version__
 from fluidymation.errors import FluidymationError
 from fluidymation.pipeline.progress import use_json_lines
 
-COMMANDS = ("check", "masks", "guides", "synth", "exemplar", "render", "ablate", "compare", "cache")
+#: The commands and their one-line help, in the order ``--help`` lists them. A command's module is
+#: imported only when that command runs, so ``--version``, ``--help`` and light commands start fast.
+COMMANDS = {
+    "check": "validate a scene file and print the resolved scene",
+    "masks": "rasterize each scene layer into a mask sequence",
+    "guides": "write views of a layer's guidance channels (flow, ext+, ext-, shape, distance)",
+    "synth": "guided synthesis of one image, EbSynth-style",
+    "exemplar": "list or make the built-in moving exemplars",
+    "render": "render a scene to a video (or up to a stage)",
+    "ablate": "render a layer with each energy term switched off, side by side",
+    "compare": "paint a layer with several stylizers, side by side, with quality figures",
+    "cache": "show or prune a scene's stage cache",
+}
 
 EXIT_USAGE = 2
 EXIT_INTERNAL = 1
@@ -36,23 +48,52 @@ class _UsageError(Exception):
     pass
 
 
-def build_parser() -> argparse.ArgumentParser:
+def _global_options(parser: argparse.ArgumentParser, *, default) -> None:
+    """The options every command takes, before or after its name (``default``: argparse.SUPPRESS on a
+    command's parser, so a flag given before the command is not reset by the command's defaults)."""
+    parser.add_argument("--debug", action="store_true", default=default, help="show tracebacks and detailed logs")
+    parser.add_argument("--strict", action="store_true", default=default,
+                        help="refuse inputs holding anything that cannot be rendered faithfully (by default a warning "
+                             "names each such element)")
+    parser.add_argument("-q", "--quiet", action="store_true", default=default, help="no progress bars")
+    parser.add_argument("--json", action="store_true", default=default,
+                        help='progress as JSON lines on stderr ({"stage", "layer", "done", "total"}) instead of bars')
+
+
+class _CommandParsers:
+    """The ``subparsers`` action as a command module sees it: each parser it adds also takes the global options."""
+
+    def __init__(self, subparsers):
+        self._subparsers = subparsers
+
+    def add_parser(self, name, **kwargs):
+        parser = self._subparsers.add_parser(name, help=COMMANDS[name], **kwargs)
+        _global_options(parser, default=argparse.SUPPRESS)
+        return parser
+
+
+def command_of(argv: list[str]) -> str | None:
+    """The command named in ``argv``: its first word that is not an option (the global options take no value)."""
+    return next((word for word in argv if not word.startswith("-")), None)
+
+
+def build_parser(argv: list[str] | None = None) -> argparse.ArgumentParser:
+    """The parser for ``argv``: the named command's full parser (its module imported), the others listed by name
+    and help only. Without ``argv``, every command's full parser."""
     parser = _ArgumentParser(
         prog="fluidymation",
         description="Make vector animations look as if real paint were moving on paper.",
     )
     parser.add_argument("--version", action="version", version=f"fluidymation {__version__}")
-    parser.add_argument("--debug", action="store_true", help="show tracebacks and detailed logs")
-    parser.add_argument("--strict", action="store_true",
-                        help="refuse inputs holding anything that cannot be rendered faithfully (by default a warning "
-                             "names each such element)")
-    parser.add_argument("-q", "--quiet", action="store_true", help="no progress bars")
-    parser.add_argument("--json", action="store_true",
-                        help='progress as JSON lines on stderr ({"stage", "layer", "done", "total"}) instead of bars')
+    _global_options(parser, default=False)
     subparsers = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_ArgumentParser)
     subparsers.required = True
-    for name in COMMANDS:
-        importlib.import_module(f"fluidymation.pipeline.commands.{name}").add_parser(subparsers)
+    chosen = None if argv is None else command_of(argv)
+    for name, help_text in COMMANDS.items():
+        if argv is None or name == chosen:
+            importlib.import_module(f"fluidymation.pipeline.commands.{name}").add_parser(_CommandParsers(subparsers))
+        else:
+            subparsers.add_parser(name, help=help_text, add_help=False)
     return parser
 
 
@@ -78,7 +119,7 @@ def main(argv: list[str] | None = None) -> int:
     debug = "--debug" in argv
     _configure_logging(debug)
     try:
-        args = build_parser().parse_args(argv)
+        args = build_parser(argv).parse_args(argv)
         use_json_lines(args.json)
         return int(args.run(args) or 0)
     except _UsageError as exc:

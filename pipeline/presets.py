@@ -81,13 +81,16 @@ def _whole(value, key):
 
 
 def parse_size(tokens) -> tuple[int, int] | None:
-    """``["W", "H"]`` or ``["WxH"]`` to (width, height); ``None`` stays ``None``."""
+    """``["W", "H"]``, ``["WxH"]`` or ``["N"]`` (a square) to (width, height); ``None`` stays ``None``."""
     if tokens is None:
         return None
     if len(tokens) == 1 and _SIZE.match(tokens[0]):
         width, height = _SIZE.match(tokens[0]).groups()
+    elif len(tokens) == 1 and tokens[0].isdigit():
+        width = height = tokens[0]
     elif len(tokens) == 2 and all(token.isdigit() for token in tokens):
         width, height = tokens
     else:
-        raise InputError(f"--size: expected `W H` or `WxH` (e.g. 256 256 or 256x256), got {' '.join(tokens)!r}")
+        raise InputError(f"--size: expected `N`, `W H` or `WxH` (e.g. 256, 256 256 or 256x256), "
+                         f"got {' '.join(tokens)!r}")
     return int(width), int(height)

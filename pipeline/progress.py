@@ -10,7 +10,6 @@ from __future__ import annotations
 import json
 import sys
 
-from tqdm import tqdm
 
 _json_lines = False
 
@@ -35,6 +34,8 @@ def progress(total: int | None, description: str, *, layer: str | None = None, q
     if _json_lines and not quiet:
         return JsonProgress(total, description, layer)
     label = description if layer is None else f"{description} {layer}"
+    from tqdm import tqdm  # here, not at import: it costs the CLI's start-up a tenth of a second
+
     return tqdm(total=total, desc=label, unit=unit, file=sys.stderr, disable=True if quiet else None, delay=1.0,
                 dynamic_ncols=True, leave=False)
 

@@ -167,14 +167,19 @@ def _frames(check: Checker) -> FrameRange | None:
 
 
 def _size(check: Checker) -> tuple[int, int] | None:
-    items = check.sequence(("size",))
-    if not items:
-        if check.has(("size",)):
-            raise check.error(("size",), "expected [width, height]")
-        return None
+    return size_at(check, ("size",), minimum=1) if check.has(("size",)) else None
+
+
+def size_at(check: Checker, path, *, minimum: int) -> tuple[int, int]:
+    """``[width, height]``, or one number for a square, at ``path``."""
+    value = check.value(path)
+    if isinstance(value, int) and not isinstance(value, bool):
+        side = check.integer(path, minimum=minimum, maximum=MAX_SIZE)
+        return side, side
+    items = check.sequence(path)
     if len(items) != 2:
-        raise check.error(("size",), f"expected [width, height], got {len(items)} values")
-    return tuple(check.integer(("size", i), minimum=1, maximum=MAX_SIZE) for i in range(2))
+        raise check.error(path, f"expected [width, height] or one number for a square, got {len(items)} values")
+    return tuple(check.integer(path + (i,), minimum=minimum, maximum=MAX_SIZE) for i in range(2))
 
 
 def _output(check: Checker, scene_path: Path) -> OutputSpec:
@@ -257,10 +262,7 @@ def _exemplar_options(check: Checker, where) -> dict:
             options["frames"] = (check.integer(where + ("frames", "start"), 0, minimum=0),
                                  check.integer(where + ("frames", "end"), None, minimum=1))
     if check.has(where + ("size",)):
-        items = check.sequence(where + ("size",))
-        if len(items) != 2:
-            raise check.error(where + ("size",), "expected [width, height]")
-        options["size"] = tuple(check.integer(where + ("size", i), minimum=8, maximum=MAX_SIZE) for i in range(2))
+        options["size"] = size_at(check, where + ("size",), minimum=8)
     return options
 
 

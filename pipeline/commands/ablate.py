@@ -19,8 +19,7 @@ from fluidymation.pipeline.render import load_layer_source
 
 def add_parser(subparsers) -> None:
     parser = subparsers.add_parser(
-        "ablate", help="render a layer with each energy term switched off, side by side",
-        description="Stylize one layer once per variant of its stylizer's ablation study (fluidymation: the "
+        "ablate", description="Stylize one layer once per variant of its stylizer's ablation study (fluidymation: the "
                     "full energy and each term switched off: bound, dir, ext, temp, uni, dir+bound), write each version to <output.dir>/ablate/<layer>/<variant>/ and a "
                     "labelled side-by-side video <output.dir>/ablate/<layer>.mp4. A term whose weight is already "
                     "0 for the layer gives no panel of its own.")

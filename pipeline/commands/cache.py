@@ -15,8 +15,7 @@ STAGE_FOLDERS = ("masks", "coverage", "stylized", "layers", "frames")
 
 def add_parser(subparsers) -> None:
     parser = subparsers.add_parser(
-        "cache", help="show or prune a scene's stage cache",
-        description="info: the finished stage work recorded for the scene (stage, layer, files, size), and the "
+        "cache", description="info: the finished stage work recorded for the scene (stage, layer, files, size), and the "
                     "size of the user cache of exemplars. prune: delete files in the scene's output folder that "
                     "no finished stage refers to (frames of older runs, leftovers of interrupted ones such as their temporary guide folders); with "
                     "--exemplars also empty the user cache of generated exemplars and their guides.")

@@ -9,11 +9,10 @@ from fluidymation.stages.rasterize import ColorTally, Params, rasterize_frame
 
 
 def add_parser(subparsers) -> None:
-    parser = subparsers.add_parser("check", help="validate a scene file and print the resolved scene",
-                                   description="Validate SCENE and print its input (with the reader and "
-                                               "renderer it uses), size, fps, frame range and, per scene "
-                                               "layer, the vector layers it selects, their fill colour and "
-                                               "z-order.")
+    parser = subparsers.add_parser(
+        "check", description="Validate SCENE and print its input (with the reader and renderer it uses), size, "
+                             "fps, frame range and, per scene layer, the vector layers it selects, their fill "
+                             "colour and z-order.")
     parser.add_argument("scene", help="the scene's YAML file")
     parser.set_defaults(run=run)
 

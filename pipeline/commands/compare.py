@@ -55,8 +55,7 @@ class Row(NamedTuple):
 
 def add_parser(subparsers) -> None:
     parser = subparsers.add_parser(
-        "compare", help="paint a layer with several stylizers, side by side, with quality figures",
-        description="Stylize one layer with each named stylizer (the layer's own with the layer's params, any other "
+        "compare", description="Stylize one layer with each named stylizer (the layer's own with the layer's params, any other "
                     "with its defaults and the scene's seed) into <output.dir>/compare/<layer>/<stylizer>/, write a "
                     "labelled side-by-side video <output.dir>/compare/<layer>.mp4, a contact sheet "
                     "<output.dir>/compare/<layer>.png (a row per stylizer: its first, middle and last frame, captioned "

@@ -26,8 +26,8 @@ from fluidymation.stages.files import read_image, write_npy, write_png, write_te
 
 
 def add_parser(subparsers) -> None:
-    parser = subparsers.add_parser("exemplar", help="list or make the built-in moving exemplars",
-                                   description="Built-in moving exemplars: simulated watercolor and crumbling charcoal.")
+    parser = subparsers.add_parser(
+        "exemplar", description="Built-in moving exemplars: simulated watercolor and crumbling charcoal.")
     actions = parser.add_subparsers(dest="action", metavar="ACTION")
     actions.required = True
     listing = actions.add_parser("list", help="names, descriptions and default parameters")

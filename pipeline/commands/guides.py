@@ -16,8 +16,7 @@ from fluidymation.stages.vector.svg_reader import sequence_files
 
 def add_parser(subparsers) -> None:
     parser = subparsers.add_parser(
-        "guides", help="write views of a layer's guidance channels (flow, ext+, ext-, shape, distance)",
-        description="Compute a layer's guidance channels over the whole scene range and write PNG views "
+        "guides", description="Compute a layer's guidance channels over the whole scene range and write PNG views "
                     "per frame: flow/ (hue = direction, brightness = speed), ext_plus/, ext_minus/, shape/, "
                     "dist/, segments/. With --raw also the arrays as .npy.")
     parser.add_argument("scene", help="the scene's YAML file")

@@ -12,9 +12,9 @@ from fluidymation.pipeline.scene import load_scene
 
 
 def add_parser(subparsers) -> None:
-    parser = subparsers.add_parser("masks", help="rasterize each scene layer into a mask sequence",
-                                   description="Write DIR/<layer>/00000.png ... (0/255; numbered from the "
-                                               "start of the scene's frame range) and DIR/layers.json.")
+    parser = subparsers.add_parser(
+        "masks", description="Write DIR/<layer>/00000.png ... (0/255; numbered from the start of the scene's "
+                             "frame range) and DIR/layers.json.")
     parser.add_argument("scene", help="the scene's YAML file")
     parser.add_argument("-o", "--output", metavar="DIR", help="output folder (default: <output.dir>/masks)")
     parser.add_argument("--frames", metavar="A:B", help="only scene frames A to B (B exclusive)")

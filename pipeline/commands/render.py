@@ -13,8 +13,7 @@ PREVIEW_SCALE = 0.5
 
 def add_parser(subparsers) -> None:
     parser = subparsers.add_parser(
-        "render", help="render a scene to a video (or up to a stage)",
-        description="Rasterize, stylize and colorize every layer, synthesize the paper, composite the layers "
+        "render", description="Rasterize, stylize and colorize every layer, synthesize the paper, composite the layers "
                     "in z-order and encode the MP4 into the scene's output.dir, with report.json (timings "
                     "and cache hits per stage and layer). Work whose inputs and parameters are unchanged is "
                     "taken from the stage cache (output.dir/.cache). Stages in order: " + ", ".join(STAGE_NAMES) + ". Frame files are "

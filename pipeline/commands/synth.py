@@ -53,8 +53,7 @@ class _Weight(argparse.Action):
 
 def add_parser(subparsers) -> None:
     parser = subparsers.add_parser(
-        "synth", help="guided synthesis of one image, EbSynth-style",
-        description="Synthesize OUT with the layout of the target guides and the look of the style "
+        "synth", description="Synthesize OUT with the layout of the target guides and the look of the style "
                     "(EbSynth's options and defaults; --weight applies to the preceding --style or --guide).",
     )
     parser.add_argument("--style", required=True, metavar="S.png", action=_Style, help="style exemplar")

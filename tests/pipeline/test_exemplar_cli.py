@@ -15,7 +15,7 @@ def test_list_shows_every_preset_with_defaults(cli):
     assert "size=256x256" in out and "frames=60" in out
 
 
-@pytest.mark.parametrize("size", [["40x32"], ["40", "32"]])
+@pytest.mark.parametrize("size", [["40x32"], ["40", "32"]])  # a square: test_cli_conventions.py
 def test_make_writes_frames_masks_flow_and_record(cli, tmp_path, size):
     out_dir = tmp_path / "bloom"
     code, _, err = cli("-q", "exemplar", "make", "watercolor-bloom", "-o", out_dir, "--seed", 3, "--size", *size,
