@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import difflib
 import math
+import os
 import re
 from pathlib import Path
 
@@ -79,7 +80,7 @@ class Checker:
     def integer(self, path: KeyPath, default=_MISSING, *, minimum=None, maximum=None) -> int:
         data = self.value(path, default)
         if data is None:
-            return None
+            return _absent(self, path, default)
         if isinstance(data, bool) or not isinstance(data, int):
             raise self.error(path, f"expected a whole number, got {_describe(data)}")
         _check_range(self, path, data, minimum, maximum)
@@ -88,7 +89,7 @@ class Checker:
     def number(self, path: KeyPath, default=_MISSING, *, minimum=None, maximum=None, above=None) -> float:
         data = self.value(path, default)
         if data is None:
-            return None
+            return _absent(self, path, default)
         if isinstance(data, bool) or not isinstance(data, (int, float)) or not math.isfinite(data):
             raise self.error(path, f"expected a number, got {_describe(data)}")
         if above is not None and not data > above:
@@ -105,7 +106,7 @@ class Checker:
     def text(self, path: KeyPath, default=_MISSING, *, choices: tuple[str, ...] | None = None) -> str:
         data = self.value(path, default)
         if data is None:
-            return None
+            return _absent(self, path, default)
         if not isinstance(data, str) or not data:
             raise self.error(path, f"expected text, got {_describe(data)}")
         if choices is not None and data not in choices:
@@ -123,6 +124,10 @@ class Checker:
         data = self.text(path, default)
         if data is None:
             return None
+        if "\0" in data:
+            raise self.error(path, f"a file path cannot hold a NUL character, got {data!r}")
+        if len(os.fsencode(data)) > 4096 or any(len(os.fsencode(part)) > 255 for part in Path(data).parts):
+            raise self.error(path, f"file name too long ({len(data)} characters)")
         return (self.base_dir / Path(data).expanduser()).resolve()
 
     def text_list(self, path: KeyPath, default=_MISSING) -> list[str]:
@@ -145,6 +150,13 @@ def _check_range(checker: Checker, path: KeyPath, value, minimum, maximum) -> No
         raise checker.error(path, f"must be at least {minimum}, got {value}")
     if maximum is not None and value > maximum:
         raise checker.error(path, f"must be at most {maximum}, got {value}")
+
+
+def _absent(check: Checker, path: KeyPath, default):
+    """What a value written as null reads as: its default, unless it has none (it is required)."""
+    if default is _MISSING:
+        raise check.error(path, "is required, got nothing (null)")
+    return default
 
 
 def _describe(value) -> str:

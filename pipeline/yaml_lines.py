@@ -9,6 +9,7 @@ import yaml
 from fluidymation.errors import SceneError
 
 MAX_NODES = 200_000  # guards against alias bombs ("billion laughs")
+MAX_DEPTH = 100  # nesting deeper than any scene needs (and than Python's recursion allows)
 
 KeyPath = tuple  # of str (mapping keys) and int (sequence indices)
 
@@ -45,6 +46,8 @@ def load_yaml(path: Path) -> LocatedYaml:
         where = f", line {mark.line + 1}" if mark is not None else ""
         problem = getattr(exc, "problem", None) or str(exc)
         raise SceneError(f"{path}{where}: malformed YAML: {problem}") from None
+    except RecursionError:
+        raise SceneError(f"{path}: malformed YAML: nested too deeply") from None
     finally:
         loader.dispose()
     if root is None:
@@ -58,6 +61,8 @@ def _build(node, path: KeyPath, lines: dict, filename: str, count: list):
     count[0] += 1
     if count[0] > MAX_NODES:
         raise SceneError(f"{filename}: too many YAML values (over {MAX_NODES}); are aliases nested?")
+    if len(path) > MAX_DEPTH:
+        raise SceneError(f"{filename}, line {node.start_mark.line + 1}: values nested more than {MAX_DEPTH} deep")
     lines[path] = node.start_mark.line + 1
     if isinstance(node, yaml.MappingNode):
         result = {}

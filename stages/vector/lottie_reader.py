@@ -163,6 +163,8 @@ def _parse_json(raw: bytes, source: str) -> dict:
         data = json.loads(raw)
     except UnicodeDecodeError:
         raise InputError(f"{source}: not a text file; expected Lottie JSON") from None
+    except RecursionError:
+        raise InputError(f"{source}: malformed JSON (values nested too deeply)") from None
     except json.JSONDecodeError as exc:
         raise InputError(f"{source}, line {exc.lineno}, column {exc.colno}: malformed JSON ({exc.msg})") from None
     if not isinstance(data, dict):
@@ -360,8 +362,23 @@ def _check_structure(data: dict, source: str) -> None:
     if not isinstance(assets, list) or not all(isinstance(asset, dict) for asset in assets):
         raise InputError(f"{source}: not a valid Lottie animation: 'assets' must be a list of objects")
     for index, asset in enumerate(assets):
+        _check_references(asset, ("id",), f"assets[{index}]", source)
         if "layers" in asset:
             _check_layers(asset["layers"], f"assets[{index}].layers", source)
+    _check_no_null_items(data, source)
+
+
+def _check_no_null_items(data: dict, source: str) -> None:
+    """No ``null`` item in a list (a point, a colour, keyframes, shapes): no Lottie list holds one, and ThorVG 1.0
+    hangs loading some (a point's first coordinate, a keyframe)."""
+    pending = [(data, "")]
+    while pending:
+        value, where = pending.pop()
+        if isinstance(value, list) and None in value:
+            raise InputError(f"{source}: not a valid Lottie animation: {where}[{value.index(None)}] is null")
+        for key, item in value.items() if isinstance(value, dict) else enumerate(value):
+            if isinstance(item, (dict, list)):
+                pending.append((item, f"{where}[{key}]" if isinstance(key, int) else f"{where}.{key}".lstrip(".")))
 
 
 def _check_layers(layers, where: str, source: str) -> None:
@@ -370,6 +387,16 @@ def _check_layers(layers, where: str, source: str) -> None:
     for index, layer in enumerate(layers):
         if not isinstance(layer, dict) or isinstance(layer.get("ty"), bool) or not isinstance(layer.get("ty"), int):
             raise InputError(f"{source}: {where}[{index}] is not a Lottie layer (needs an integer 'ty')")
+        _check_references(layer, ("ind", "parent", "tp", "refId"), f"{where}[{index}]", source)
+
+
+def _check_references(item: dict, keys: tuple[str, ...], where: str, source: str) -> None:
+    """The keys by which layers and assets refer to each other are plain values (they are looked up)."""
+    for key in keys:
+        value = item.get(key)
+        if isinstance(value, (list, dict)):
+            raise InputError(f"{source}: not a valid Lottie animation: {where}.{key} must be a number or text, "
+                             f"got a JSON {'list' if isinstance(value, list) else 'object'}")
 
 
 def _units(data: dict, split: tuple[str, ...]) -> dict[str, list[_Unit]]:
@@ -496,6 +523,9 @@ def _unsupported_shapes(shapes: list, where: str) -> list[Unsupported]:
         if not isinstance(shape, dict) or shape.get("hd"):
             continue
         name, kind = f"{where}[{index}] '{shape.get('nm', '')}'", shape.get("ty")
+        if not isinstance(kind, str):  # a list or mapping cannot be looked up; no such shape type either
+            found.append(Unsupported(name, f"shape type {kind!r}, unknown to the player: not drawn"))
+            continue
         if kind == "mm" and shape.get("mm", 1) in _MERGE_AS_DRAWN:
             continue
         if kind in _IGNORED_SHAPES:
@@ -510,14 +540,15 @@ def _unsupported_shapes(shapes: list, where: str) -> list[Unsupported]:
 
 def _unsupported_text(layer: dict, name: str, data: dict) -> list[Unsupported]:
     """Text in a font the player cannot draw: one the file neither embeds (``data:font/ttf``) nor gives glyphs of."""
-    fonts = {font.get("fName"): font for font in _list(_dict(data.get("fonts")).get("list")) if isinstance(font, dict)}
-    families = {char.get("fFamily") for char in _list(data.get("chars")) if isinstance(char, dict)}
+    fonts = {str(font.get("fName")): font for font in _list(_dict(data.get("fonts")).get("list"))
+             if isinstance(font, dict)}
+    families = {str(char.get("fFamily")) for char in _list(data.get("chars")) if isinstance(char, dict)}
     keyframes = _list(_dict(_dict(layer.get("t")).get("d")).get("k"))
     missing = []
     for font_name in dict.fromkeys(str(_dict(key.get("s")).get("f")) for key in keyframes if isinstance(key, dict)):
         font = _dict(fonts.get(font_name))
         embedded = str(font.get("fPath", "")).startswith("data:font/ttf")
-        if not embedded and font.get("fFamily") not in families:
+        if not embedded and str(font.get("fFamily")) not in families:
             missing.append(font_name)
     return [Unsupported(name, f"text in the font '{font_name}', which the file neither embeds nor gives glyphs of: "
                               "the player draws no text") for font_name in missing]

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import cairocffi
 import cairosvg.parser
 import cairosvg.surface
 import numpy as np
@@ -25,6 +26,9 @@ def render_svg(svg: bytes, size: tuple[int, int], source: str) -> np.ndarray:
         raise InputError(f"{source}: {exc}") from None
     except (ValueError, TypeError, KeyError, IndexError, AttributeError, ZeroDivisionError) as exc:
         raise InputError(f"{source}: cannot be rendered as SVG ({type(exc).__name__}: {exc})") from None
+    except cairocffi.CairoError as exc:  # cairo refuses what cairosvg passes on, e.g. an ellipse of ry="nan"
+        raise InputError(f"{source}: cannot be rendered as SVG (cairo: {exc.args[0] if exc.args else exc}; "
+                         "is a length or transform not a finite number?)") from None
     image = surface.cairo
     image.flush()
     stride = image.get_stride()

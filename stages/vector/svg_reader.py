@@ -233,7 +233,11 @@ class SvgDocument(_StaticTrees):
     def frame_range(self, fps):
         if not self.animations:
             return 0, 1
-        return 0, frames_in(max(animation.duration() for animation in self.animations), fps)
+        duration = max(animation.duration() for animation in self.animations)
+        if not math.isfinite(duration * fps):  # e.g. animation-iteration-count: 1e308 of a 1 s animation
+            raise InputError(f"{self.path}: the animations run for {duration:g} s, too long to count its frames; "
+                             "give the scene's frames: {start, end}")
+        return 0, frames_in(duration, fps)
 
     def isolate(self, names, time_seconds) -> SvgFrame:
         return SvgFrame(_svg_bytes(self.static_tree(names, time_seconds)), str(self.path))
