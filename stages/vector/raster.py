@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import re
+
 import cairocffi
 import cairosvg.parser
 import cairosvg.surface
@@ -21,6 +23,7 @@ def render_svg(svg: bytes, size: tuple[int, int], source: str) -> np.ndarray:
     width, height = size
     try:
         tree = cairosvg.parser.Tree(bytestring=svg, url_fetcher=refuse_fetch, unsafe=False)
+        _refuse_huge_radii(tree, source)
         surface = cairosvg.surface.PNGSurface(tree, None, 96, output_width=width, output_height=height)
     except InputError as exc:
         raise InputError(f"{source}: {exc}") from None
@@ -37,6 +40,25 @@ def render_svg(svg: bytes, size: tuple[int, int], source: str) -> np.ndarray:
     if bgra.shape[:2] != (height, width):
         raise InputError(f"{source}: rendered at {bgra.shape[1]}x{bgra.shape[0]} instead of {width}x{height}")
     return _bgra_to_rgba(bgra)
+
+
+#: Radii beyond this (user units) are refused: cairo's arc loops for ever on radii near 1e308.
+MAX_RADIUS = 1e7
+_RADII = {"circle": ("r",), "ellipse": ("rx", "ry"), "rect": ("rx", "ry")}
+_LEADING_NUMBER = re.compile(r"\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)")
+
+
+def _refuse_huge_radii(node, source: str) -> None:
+    """An InputError naming the element whose circle or ellipse radius is beyond :data:`MAX_RADIUS`."""
+    pending = [node]
+    while pending:
+        node = pending.pop()
+        for name in _RADII.get(node.tag, ()):
+            match = _LEADING_NUMBER.match(node.get(name) or "")
+            if match and not abs(float(match.group(1))) <= MAX_RADIUS:
+                raise InputError(f"{source}: <{node.tag} {name}=\"{node.get(name)}\">: a radius beyond "
+                                 f"{MAX_RADIUS:g} cannot be drawn")
+        pending.extend(node.children)
 
 
 def _bgra_to_rgba(bgra: np.ndarray) -> np.ndarray:

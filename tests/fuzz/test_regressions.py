@@ -101,3 +101,18 @@ def test_svg_endless_css_animation(cli, tmp_path):  # was OverflowError in frame
         '<g id="g"><rect width="8" height="8"/></g></svg>')
     write_scene(tmp_path, "input: long.svg\n")
     refused(cli, tmp_path / "scene.yaml", "long.svg", "too long to count its frames")
+
+
+@pytest.mark.parametrize("svg", ['<ellipse cx="16" cy="16" rx="8" ry="1e308"/>',
+                                 '<ellipse cx="16" cy="16" rx="8" ry="32"><animate attributeName="ry" from="-1e308" '
+                                 'to="46" dur="1s" fill="freeze"/></ellipse>'])
+def test_svg_radius_beyond_reason(tmp_path, svg):  # cairo's arc looped for ever (a subprocess: a hang is a failure)
+    import subprocess
+    import sys
+
+    (tmp_path / "huge.svg").write_text(f'<svg xmlns="http://www.w3.org/2000/svg" width="32" height="32">{svg}</svg>')
+    write_scene(tmp_path, "input: huge.svg\nframes: {start: 0, end: 2}\n")
+    done = subprocess.run([sys.executable, "-m", "fluidymation", "-q", "check", str(tmp_path / "scene.yaml")],
+                          capture_output=True, text=True, timeout=60)
+    assert done.returncode == 2, done.stderr
+    assert "huge.svg" in done.stderr and 'ry="' in done.stderr and "radius beyond" in done.stderr, done.stderr
