@@ -16,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-from fluidymation.stages import guides, keyframe_morph
+from fluidymation.stages import keyframe_morph
 from fluidymation.stages.keyframes import read_keyframe
 from fluidymation.stages.stylizer import Frame, StylizeJob, Stylizer
 
@@ -49,10 +49,8 @@ class KeyframeStylizer(Stylizer):
 
     def stylize(self, job: StylizeJob, params: keyframe_morph.Params):
         root = Path(job.work_dir or job.cache_dir) / "morph"
-        motion = guides.compute_guides(job.masks, job.frame_count, params=job.guide_params,
-                                       cache_dir=Path(job.cache_dir) / "guides", given_flow=job.given_flow)
         keyframes = read_keyframes(job)
-        keyframe_morph.prepare(root, job.masks, lambda j: motion.read("flow", j), job.frame_count, keyframes)
+        keyframe_morph.prepare(root, job.masks, job.motion(), job.frame_count, keyframes)
         shape = next(iter(keyframes.values())).shape[:2]
         map_tasks = job.map_tasks or keyframe_morph.serial_map
         total = keyframe_morph.sweep_count(params, shape)

@@ -38,10 +38,15 @@ class LayerRaster:
 
     @property
     def straight_rgb(self) -> np.ndarray:
-        """(H, W, 3) float32 in [0, 1]: the layer's own colour where it shows (premultiplication undone), 0 elsewhere."""
-        alpha = self.rgba[:, :, 3:4].astype(np.float32)
-        rgb = self.rgba[:, :, :3].astype(np.float32) / np.maximum(alpha, 1.0)
-        return np.clip(rgb, 0.0, 1.0)
+        """(H, W, 3) float32 in [0, 1]: the layer's own colour where it shows, 0 elsewhere."""
+        return unpremultiplied(self.rgba)
+
+
+def unpremultiplied(rgba: np.ndarray) -> np.ndarray:
+    """(..., 3) float32 in [0, 1]: the colour of 8-bit premultiplied ``rgba`` (..., 4) with the alpha divided out
+    (0 where the alpha is 0)."""
+    alpha = rgba[..., 3:4].astype(np.float32)
+    return np.clip(rgba[..., :3].astype(np.float32) / np.maximum(alpha, 1.0), 0.0, 1.0)
 
 
 def rasterize_frame(renderer: Renderer, document: VectorDocument, vector_layers: tuple[str, ...], frame: int,
@@ -64,10 +69,9 @@ class ColorTally:
         if opaque.size:
             self.opaque.update(_count_colors(opaque))
         elif not self.opaque:
-            covered = rgba[alpha > 0].astype(np.float32)
+            covered = rgba[alpha > 0]
             if covered.size:
-                straight = np.clip(np.rint(covered[:, :3] * 255.0 / covered[:, 3:4]), 0, 255).astype(np.uint8)
-                self.partial.update(_count_colors(straight))
+                self.partial.update(_count_colors(np.rint(unpremultiplied(covered) * 255.0).astype(np.uint8)))
 
     def dominant(self) -> str | None:
         """'#rrggbb' of the most common colour, or None when the layer never shows."""

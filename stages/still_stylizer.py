@@ -11,12 +11,11 @@ from __future__ import annotations
 
 import logging
 from importlib import resources
-from pathlib import Path
 
 import numpy as np
 
 from fluidymation.engine.nnf import NNF
-from fluidymation.stages import guides, still
+from fluidymation.stages import still
 from fluidymation.stages.stylizer import StylizeJob, Stylizer
 
 log = logging.getLogger(__name__)
@@ -38,11 +37,7 @@ class StillStylizer(Stylizer):
         regions = still.layer_regions(((job.colours(j), job.masks(j)) for j in range(job.frame_count)),
                                       painting.regions, mode=job.segments, segment_map=job.segment_map,
                                       where=f"layer '{job.layer}'")
-        flow = None
-        if params.follow_motion and job.frame_count > 1:
-            motion = guides.compute_guides(job.masks, job.frame_count, params=job.guide_params,
-                                           cache_dir=Path(job.cache_dir) / "guides", given_flow=job.given_flow)
-            flow = lambda j: motion.read("flow", j)  # noqa: E731
+        flow = job.motion() if params.follow_motion and job.frame_count > 1 else None
         first, stop = job.frames
         previous = None
         if job.resume is not None:

@@ -89,6 +89,13 @@ class StylizeJob:
     segment_map: tuple[tuple[str, str], ...] = ()
     layer: str = ""
 
+    def motion(self) -> Callable[[int], np.ndarray]:
+        """``flow(j)``: the layer's motion into frame j as its guides see it (``given_flow`` where known, else the
+        masks' estimate), the guides computed once into the scratch folder."""
+        cache = guides.compute_guides(self.masks, self.frame_count, params=self.guide_params,
+                                      cache_dir=Path(self.cache_dir) / "guides", given_flow=self.given_flow)
+        return lambda j: cache.read("flow", j)
+
 
 class Stylizer(ABC):
     """Base of the stylizer plugins (see the module docstring)."""

@@ -115,10 +115,8 @@ def _names(text: str) -> list[str]:
 
 
 def _stylizer(layers: LayerPanels, name: str):
-    """The registered stylizer ``name``, checked against the layer (a keyframes stylizer needs its keyframes)."""
-    if name not in stylizer_names():
-        raise InputError(f"--stylizers: no stylizer called '{name}' is registered; the registered ones are "
-                         f"{', '.join(stylizer_names())}")
+    """The installed stylizer ``name`` (an unknown name is an error listing the installed ones), checked against
+    the layer (a keyframes stylizer needs its keyframes)."""
     stylizer = get_stylizer(name)
     if stylizer.uses_keyframes and not layers.layer.spec.keyframes:
         raise InputError(f"layer '{layers.layer.name}': the stylizer '{name}' paints from keyframes and the layer has "

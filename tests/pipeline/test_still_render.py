@@ -59,6 +59,14 @@ def monkeypatch_module():
         yield patch
 
 
+def _copy(folder, work):
+    """The map scene's files copied to a fresh folder ``work`` (for a scene of its own)."""
+    work.mkdir()
+    for name in ("map.svg", "crayon.png", "crayon-seg.png"):
+        (work / name).write_bytes((folder / name).read_bytes())
+    return work
+
+
 def _frames(out, layer):
     return [iio.imread(path).astype(np.float32) / 255 for path in sorted((out / "stylized" / layer).glob("*.png"))]
 
@@ -95,10 +103,7 @@ def test_the_boat_carries_its_paint_along(rendered):
     ("", "{image: crayon.png, segments: small.png}", "small.png: the segments image is 8x8, the painting 64x64"),
 ])
 def test_bad_regions_are_named(folder, tmp_path, capsys, layer, exemplar, message):
-    work = tmp_path / "scene"
-    work.mkdir()
-    for name in ("map.svg", "crayon.png", "crayon-seg.png"):
-        (work / name).write_bytes((folder / name).read_bytes())
+    work = _copy(folder, tmp_path / "scene")
     iio.imwrite(work / "small.png", np.zeros((8, 8, 3), np.uint8))
     scene = _scene(work, map_layer=layer, frames=1, **({"exemplar": exemplar} if exemplar else {}))
     assert main(["-q", "render", str(scene)]) == 2
@@ -134,10 +139,7 @@ def test_lazyfluids_texture_follows_a_translating_disk(tmp_path):
 
 def test_an_exemplar_painted_to_its_edges_still_paints_a_fluidymation_layer(folder, tmp_path):
     """A painting with no unpainted margin has no border segment: the target's border matches its one segment."""
-    work = tmp_path / "scene"
-    work.mkdir()
-    for name in ("map.svg", "crayon.png", "crayon-seg.png"):
-        (work / name).write_bytes((folder / name).read_bytes())
+    work = _copy(folder, tmp_path / "scene")
     scene = _scene(work, map_layer=", stylizer: fluidymation, params: {opt_iters: [1], pm_iters: [1]}", frames=2)
     assert main(["-q", "render", str(scene), "--layer", "map", "--until", "stylize"]) == 0
     frame = _frames(work / "out", "map")[0]
