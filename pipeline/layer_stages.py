@@ -343,7 +343,7 @@ def colorize_layer(plan: Plan, layer: PlannedLayer, window: range, source, param
     """
     rgb, segment = source.rgb, source.segment
     paper = colorize.estimate_paper(rgb, segment)
-    unit = colorize.full_density(rgb, segment, paper)
+    unit = colorize.full_density(rgb, segment, paper) if params.mode == "layer" else 1.0  # only layer colour uses it
     del rgb, segment
     written = []
     with progress(len(window), "colorize", layer=layer.name, quiet=quiet) as bar:

@@ -80,7 +80,7 @@ def test_its_parameters_are_checked_against_its_own_params(cli, tmp_path, monkey
 def test_an_unknown_stylizer_is_a_scene_error_listing_the_installed_ones(cli, tmp_path, flat_installed):
     scene = write_scene(tmp_path, blob_scene(layers='  - {name: blob, stylizer: flatt}\n'))
     code, _, err = cli("check", scene)
-    assert code == 2 and "layers[0].stylizer: 'flatt' is not one of flat, fluidymation, keyframes, lazyfluids, still (did you mean 'flat'?)" in err
+    assert code == 2 and "layers[0].stylizer: 'flatt' is not one of cartoon, flat, fluidymation, keyframes, lazyfluids, still (did you mean 'flat'?)" in err
 
 
 def test_a_fresh_process_finds_the_stylizer_on_its_path(tmp_path, command_line):
