@@ -37,7 +37,7 @@ class OneFrame:
 
     def __init__(self, source, index: int):
         if not 0 <= index < source.frame_count:
-            raise ParameterError(f"exemplar_frame {index}: the exemplar has {source.frame_count} frames")
+            raise ParameterError("exemplar_frame", f"exemplar_frame {index}: the exemplar has {source.frame_count} frames")
         self.source, self.index = source, index
         self.frame_count = 1
         self.ext_max = source.ext_max

@@ -76,12 +76,13 @@ class Params:
     seed: int = 0
 
     def __post_init__(self):
-        if min(self.w_style, self.w_guide, self.uniformity, self.edge_band) < 0:
-            raise ParameterError("w_style, w_guide, uniformity and edge_band must be ≥ 0")
+        for name in ("w_style", "w_guide", "uniformity", "edge_band"):
+            if getattr(self, name) < 0:
+                raise ParameterError(name, f"{name} must be ≥ 0, got {getattr(self, name)}")
         if self.w_style == 0:
-            raise ParameterError("w_style must be above 0: without it nothing looks like the painting")
+            raise ParameterError("w_style", "w_style must be above 0: without it nothing looks like the painting")
         if self.exemplar_frame < 0:
-            raise ParameterError(f"exemplar_frame must be ≥ 0, got {self.exemplar_frame}")
+            raise ParameterError("exemplar_frame", f"exemplar_frame must be ≥ 0, got {self.exemplar_frame}")
 
     def synthesis(self) -> SynthesisParams:
         return SynthesisParams(patch_size=self.patch_size, pyramid_levels=self.pyramid_levels,
@@ -126,7 +127,7 @@ def painting_from(source, frame: int) -> Painting:
     """Frame ``frame`` of a stored exemplar with its regions; an exemplar without ``segments:`` is one region,
     its mask, coloured by its mean paint."""
     if frame >= source.frame_count:
-        raise ParameterError(f"exemplar_frame {frame}: the exemplar has {source.frame_count} frames")
+        raise ParameterError("exemplar_frame", f"exemplar_frame {frame}: the exemplar has {source.frame_count} frames")
     window = source.window(frame, frame + 1)
     rgb = window.rgb[0]
     regions = source.regions

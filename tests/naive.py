@@ -295,3 +295,45 @@ def naive_scatter_vote(source, frames, coords, patch_size, weight, shape):
                     total[ty + dy, tx + dx] += weight * source[py, px]
                     weights[ty + dy, tx + dx] += weight
     return total, weights
+
+
+def naive_shift(before, after, weight, radius=4):
+    """The (dx, dy) that best moves ``before`` onto ``after`` where ``weight`` (H, W) > 0 in ``after``: the integer
+    shift of least weighted SSD over every shift within ``radius``, refined by a parabola through its neighbours."""
+    import numpy as np
+
+    height, width = weight.shape
+    costs = np.full((2 * radius + 1, 2 * radius + 1), np.inf)
+    ys, xs = np.nonzero(weight > 0)
+    for dy in range(-radius, radius + 1):
+        for dx in range(-radius, radius + 1):
+            sy, sx = ys - dy, xs - dx
+            keep = (sy >= 0) & (sy < height) & (sx >= 0) & (sx < width)
+            diff = after[ys[keep], xs[keep]] - before[sy[keep], sx[keep]]
+            costs[dy + radius, dx + radius] = (weight[ys[keep], xs[keep], None] * diff ** 2).sum() / keep.sum()
+    iy, ix = np.unravel_index(np.argmin(costs), costs.shape)
+    shift = []
+    for axis, (i, line) in enumerate(((ix, costs[iy]), (iy, costs[:, ix]))):
+        offset = 0.0
+        if 0 < i < len(line) - 1:
+            curvature = line[i - 1] - 2 * line[i] + line[i + 1]
+            if curvature > 0:
+                offset = 0.5 * (line[i - 1] - line[i + 1]) / curvature
+        shift.append(i - radius + offset)
+    return np.array(shift)
+
+
+def naive_patch_distance(image, sources, centres, patch_size):
+    """For each (x, y) in ``centres``, the least mean squared difference between ``image``'s patch there and any
+    whole patch of any of ``sources`` (each (H, W, C)); their mean."""
+    import numpy as np
+
+    half = patch_size // 2
+    best = []
+    windows = [np.lib.stride_tricks.sliding_window_view(source, (patch_size, patch_size), axis=(0, 1))
+               .reshape(-1, source.shape[2] * patch_size * patch_size) for source in sources]
+    library = np.concatenate(windows)
+    for x, y in centres:
+        patch = image[y - half:y + half + 1, x - half:x + half + 1].transpose(2, 0, 1).reshape(-1)
+        best.append(((library - patch) ** 2).mean(axis=1).min())
+    return float(np.mean(best))

@@ -5,7 +5,7 @@ import pytest
 
 from fluidymation import quality
 from fluidymation.engine.uniformity import budget_scales
-from fluidymation.errors import InputError
+from fluidymation.errors import InputError, ParameterError
 from fluidymation.stages import regions as regions_module
 from fluidymation.stages import still
 from fluidymation.stages.regions import Regions
@@ -153,3 +153,21 @@ def test_a_run_resumed_from_a_finished_frames_state_continues_with_the_same_fram
                                      previous=previous))
     assert [frame.index for frame in rest] == [2, 3]
     assert all(np.array_equal(a.rgba, b.rgba) for a, b in zip(rest, whole[2:]))
+
+
+@pytest.mark.parametrize("values, name", [({"w_style": -1.0}, "w_style"), ({"w_style": 0.0}, "w_style"),
+                                          ({"edge_band": -2.0}, "edge_band"), ({"exemplar_frame": -1}, "exemplar_frame")])
+def test_bad_parameters_are_refused_naming_them(values, name):
+    with pytest.raises(ParameterError, match=name) as caught:
+        still.Params(**values)
+    assert caught.value.name == name
+
+
+def test_an_exemplar_frame_past_the_exemplar_is_refused_naming_it():
+    from fluidymation.stages.lazyfluids_stylizer import OneFrame
+
+    class TwoFrames:
+        frame_count, ext_max = 2, 1.0
+
+    with pytest.raises(ParameterError, match="exemplar_frame 2: the exemplar has 2 frames"):
+        OneFrame(TwoFrames(), 2)
