@@ -8,11 +8,17 @@ the costs of the neighbouring integer offsets, then the dense flow is the biline
 interpolation of the vertex motions. The flow of frame k is the motion from frame k−1 to
 k at frame k's pixels, ``(dx, dy)`` px/frame with y down, as everywhere in Fluidymation.
 The vertices are visited in scan order (reverse on odd iterations), serially, and random
-numbers come from a counter-based hash, so the result is deterministic.
+numbers come from a counter-based hash, so the result is deterministic; a vertex whose match
+is exact (still paper) is not searched again. :func:`motion_sequence` estimates the
+frame pairs of a sequence on numba's threads at once (the kernels release the GIL), each
+pair as :func:`estimate_motion` alone would.
 """
 
 from __future__ import annotations
 
+from concurrent.futures import ThreadPoolExecutor
+
+import numba
 import numpy as np
 
 from fluidymation.engine._jit import kernel
@@ -49,6 +55,11 @@ def _grid_patchmatch(current, previous, spacing, half, search_radius, iterations
     cost = np.empty((rows, cols), np.float64)
     key = _key4(seed, frame, 0, 0)
     draw = 0
+    windows = 0  # random-search windows per vertex: radii search_radius, halved, down to 1
+    radius = search_radius
+    while radius >= 1:
+        windows += 1
+        radius //= 2
     for gy in range(rows):
         for gx in range(cols):
             dx = _random_below(key, draw, 2 * search_radius + 1) - search_radius
@@ -64,6 +75,9 @@ def _grid_patchmatch(current, previous, spacing, half, search_radius, iterations
             flat = index if step == 1 else rows * cols - 1 - index
             gy = flat // cols
             gx = flat % cols
+            if cost[gy, gx] == 0.0:  # an exact match (still paper, say): no candidate can be lower
+                draw += 2 * windows  # the random numbers its search would have drawn
+                continue
             cx = gx * spacing
             cy = gy * spacing
             best_dx = offset[gy, gx, 0]
@@ -187,3 +201,34 @@ def estimate_motion(previous, current, *, spacing=3, patch_size=9, search_radius
     offset, cost = _grid_patchmatch(current, previous, spacing, half, search_radius, iterations, seed, frame)
     refined = _subpixel(current, previous, offset, cost, spacing, half)
     return -_bilinear_fill(refined, spacing, current.shape[0], current.shape[1])
+
+
+def motion_sequence(frames, *, progress=None, seed=0, **options):
+    """Flows of consecutive frames: ``flow[k]`` from frame k−1 to k (as :func:`estimate_motion` with ``frame=k``)
+    for k ≥ 1, and ``flow[0] = flow[1]``; the pairs on numba's threads, the result independent of their count.
+
+    Parameters
+    ----------
+    frames : (T, H, W, C) float32, T ≥ 2
+    progress : callable, optional
+        ``progress(done, total)`` as pairs finish, in order.
+    seed, options
+        As :func:`estimate_motion`.
+
+    Returns
+    -------
+    (T, H, W, 2) float32
+    """
+    count = len(frames)
+    flow = np.zeros(np.shape(frames)[:3] + (2,), np.float32)
+
+    def pair(k):
+        return estimate_motion(frames[k - 1], frames[k], seed=seed, frame=k, **options)
+
+    with ThreadPoolExecutor(max_workers=max(1, min(numba.get_num_threads(), count - 1))) as pool:
+        for k, result in enumerate(pool.map(pair, range(1, count)), start=1):
+            flow[k] = result
+            if progress is not None:
+                progress(k, count - 1)
+    flow[0] = flow[1]
+    return flow

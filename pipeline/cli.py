@@ -29,7 +29,7 @@ COMMANDS = {
     "render": "render a scene to a video (or up to a stage)",
     "ablate": "render a layer with each energy term switched off, side by side",
     "compare": "paint a layer with several stylizers, side by side, with quality figures",
-    "resynth": "synthesize a new clip with a drawn clip's geometry and motion (seed 004)",
+    "resynth": "synthesize a new clip with a drawn clip's geometry and motion (Hao et al. 2019)",
     "cache": "show or prune a scene's stage cache",
 }
 

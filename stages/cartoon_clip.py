@@ -23,7 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import ndimage
 
-from fluidymation.engine.motion import estimate_motion
+from fluidymation.engine.motion import motion_sequence
 from fluidymation.errors import InputError
 
 #: The eight directions of the geometry samples, 45° apart (y down).
@@ -192,14 +192,9 @@ def analyse_clip(rgb: np.ndarray, mask: np.ndarray, *, name: str,
     _check_still_background(rgb, mask, name)
     alpha = mask.astype(np.float32)
     colour = np.concatenate([rgb * alpha[..., None], alpha[..., None]], axis=-1).astype(np.float32)
-    flow = np.zeros(rgb.shape[:3] + (2,), np.float32)
-    for index in range(1, count):
-        flow[index] = estimate_motion(rgb[index - 1], rgb[index], spacing=motion.spacing,
-                                      patch_size=motion.patch_size, search_radius=motion.search_radius,
-                                      iterations=motion.iterations, seed=seed, frame=index)
-        if progress is not None:
-            progress(index, count - 1)
-    flow[0] = flow[1]
+    flow = motion_sequence(rgb, spacing=motion.spacing, patch_size=motion.patch_size,
+                           search_radius=motion.search_radius, iterations=motion.iterations, seed=seed,
+                           progress=progress)
     samples = np.stack([geometry_samples(alpha[index], boxes[index]) for index in range(count)])
     return Clip(colour=colour, motion=flow, samples=samples, boxes=np.array(boxes))
 

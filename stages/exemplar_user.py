@@ -21,7 +21,7 @@ from pathlib import Path
 import numpy as np
 from scipy import ndimage
 
-from fluidymation.engine.motion import estimate_motion
+from fluidymation.engine.motion import motion_sequence
 from fluidymation.errors import InputError, StageError
 from fluidymation.stages.files import read_image, sequence_paths
 
@@ -133,7 +133,7 @@ def image_sequence(spec: str) -> list[Path]:
     path = Path(spec)
     if path.is_dir():
         return [p for p in sequence_paths(str(path / "*")) if p.suffix.lower() in IMAGE_SUFFIXES]
-    return sequence_paths(spec)
+    return [p for p in sequence_paths(spec) if not p.is_dir()]  # a pattern's folders are no frames
 
 
 def _read_frames(spec: str) -> list[np.ndarray]:
@@ -255,12 +255,6 @@ def motion_flow(rgb: np.ndarray, *, seed: int = 0, progress=None) -> np.ndarray:
     -------
     (T, H, W, 2) float32, px/frame, y down.
     """
-    count = rgb.shape[0]
-    flow = np.zeros(rgb.shape[:3] + (2,), np.float32)
-    for k in range(1, count):
-        flow[k] = estimate_motion(rgb[k - 1], rgb[k], seed=seed, frame=k)
-        if progress is not None:
-            progress(k, count - 1)
-    if count > 1:
-        flow[0] = flow[1]
-    return flow
+    if rgb.shape[0] < 2:
+        return np.zeros(rgb.shape[:3] + (2,), np.float32)
+    return motion_sequence(rgb, seed=seed, progress=progress)

@@ -1,7 +1,7 @@
 """Regenerate the README's example videos and stills in docs/examples/ from the bundled examples.
 
 Run from the repository: ``.venv/bin/python docs/examples/make_examples.py [NAME ...]``
-(names: wave, blob, squiggle, puff, map, ablate-blob, flow-gear, compare-boat; default all). Each example scene is
+(names: wave, blob, squiggle, puff, map, boil, ablate-blob, flow-gear, compare-boat, boil-resynth; default all). Each example scene is
 rendered with the installed ``fluidymation`` into its own ``examples/<name>/out/``; its video
 is copied here and five of its frames are laid side by side, 4 px apart, as ``<name>.jpg``.
 ``ablate-blob`` runs ``fluidymation ablate`` on the blob layer and keeps one frame of its
@@ -10,7 +10,8 @@ the masks (``flow: masks``), from the geometry (``flow: vector``, the default) a
 geometry with the stylizer's ``carry: true``, and sets the videos side by side, labelled
 (``flow-gear.mp4``; frame 24 as ``flow-gear.jpg``). ``compare-boat`` runs ``fluidymation compare``
 on the boat of ``examples/map`` with the still, lazyfluids and fluidymation stylizers and keeps
-its contact sheet (``compare-boat.jpg``).
+its contact sheet (``compare-boat.jpg``). ``boil-resynth`` runs ``fluidymation resynth`` on
+``examples/boil/clip`` for 48 frames and lays five of them side by side, over the clip's paper.
 """
 
 from __future__ import annotations
@@ -31,7 +32,8 @@ REPOSITORY = Path(__file__).resolve().parents[2]
 HERE = Path(__file__).resolve().parent
 #: Which frames of each example's video make its still.
 STILL_FRAMES = {"wave": (0, 12, 24, 36, 47), "blob": (0, 12, 24, 36, 47), "squiggle": (2, 8, 14, 20, 23),
-                "puff": (0, 6, 12, 18, 23), "map": (0, 6, 12, 18, 23)}
+                "puff": (0, 6, 12, 18, 23), "map": (0, 6, 12, 18, 23), "boil": (0, 8, 16, 24, 32, 40)}
+RESYNTH_FRAMES = (0, 12, 24, 36, 47)
 ABLATION_FRAME = 24
 GAP = 4
 
@@ -90,7 +92,15 @@ def make_stylizer_comparison() -> None:
     iio.imwrite(HERE / "compare-boat.jpg", sheet[..., :3], quality=90)
 
 
-SPECIAL = {"ablate-blob": make_ablation, "flow-gear": make_flow_comparison, "compare-boat": make_stylizer_comparison}
+def make_resynthesis() -> None:
+    out = REPOSITORY / "examples" / "boil" / "out" / "resynth"
+    fluidymation("resynth", "examples/boil/clip", "-o", str(out), "--frames", "48")
+    frames = iio.imread(out / "resynth.mp4", plugin="pyav")
+    iio.imwrite(HERE / "boil-resynth.jpg", side_by_side([frames[index] for index in RESYNTH_FRAMES]), quality=90)
+
+
+SPECIAL = {"ablate-blob": make_ablation, "flow-gear": make_flow_comparison, "compare-boat": make_stylizer_comparison,
+           "boil-resynth": make_resynthesis}
 
 
 def main() -> None:

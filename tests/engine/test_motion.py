@@ -1,10 +1,11 @@
 """Grid-based PatchMatch motion estimation."""
 
+import numba
 import numpy as np
 import pytest
 from scipy.ndimage import gaussian_filter, shift
 
-from fluidymation.engine.motion import estimate_motion
+from fluidymation.engine.motion import estimate_motion, motion_sequence
 
 
 def texture(height=64, width=80, seed=3):
@@ -56,3 +57,19 @@ def test_rejects_bad_arguments():
         estimate_motion(np.zeros((4, 4, 3)), np.zeros((5, 4, 3)))
     with pytest.raises(ValueError):
         estimate_motion(np.zeros((4, 4, 3)), np.zeros((4, 4, 3)), patch_size=4)
+
+
+def test_a_sequence_s_pairs_match_the_pairs_alone_on_any_thread_count():
+    rng = np.random.default_rng(4)
+    frames = np.stack([np.roll(rng.random((20, 24, 3)), shift, axis=1) for shift in (0, 1, 3, 4)]).astype(np.float32)
+    options = dict(spacing=3, patch_size=5, search_radius=4, iterations=6, seed=2)
+    alone = [estimate_motion(frames[k - 1], frames[k], frame=k, **options) for k in range(1, 4)]
+    threads = numba.get_num_threads()
+    try:
+        for count in (1, threads):
+            numba.set_num_threads(count)
+            flow = motion_sequence(frames, **options)
+            assert all(np.array_equal(flow[k], alone[k - 1]) for k in range(1, 4))
+            assert np.array_equal(flow[0], flow[1])
+    finally:
+        numba.set_num_threads(threads)

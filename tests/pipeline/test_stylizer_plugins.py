@@ -34,7 +34,7 @@ def _ran(out):
 
 def test_a_stylizer_from_another_distribution_renders_a_layer(cli, tmp_path, monkeypatch, flat_installed):
     monkeypatch.setenv("FLUIDYMATION_CACHE", str(tmp_path / "cache"))
-    assert stylizers.stylizer_names() == ("flat", "fluidymation", "keyframes", "lazyfluids", "still")
+    assert stylizers.stylizer_names() == ("cartoon", "flat", "fluidymation", "keyframes", "lazyfluids", "still")
     scene = write_scene(tmp_path, blob_scene(layers=FLAT_LAYER, params="{}"))
     code, out, _ = cli("check", scene)
     assert code == 0 and "blob: z=" in out and "stylizer flat v1" in out
