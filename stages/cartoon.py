@@ -40,7 +40,9 @@ from fluidymation.stages.cartoon_clip import (
 )
 
 NAME = "cartoon"
-VERSION = 1
+VERSION = 2
+#: How far (px) past the target subject the voted outline may reach; what patches vote farther out is dropped.
+OUTLINE_REACH = 2
 
 
 @dataclass(frozen=True)
@@ -197,6 +199,7 @@ class CartoonSynthesis:
             result = synthesize_prepared(self.prepared, inputs, synthesis)
             rgba = np.clip(result.image, 0.0, 1.0).astype(np.float32)
             rgba[..., :3] = np.minimum(rgba[..., :3], rgba[..., 3:])
+            rgba *= ndimage.binary_dilation(segment >= 0, iterations=OUTLINE_REACH)[..., None]  # no stray specks
             nnf = result.nnf
         newest = np.concatenate([rgba[None], history[:-1]]) if self.depth else history
         return CartoonFrame(index, rgba, nnf, newest)
