@@ -66,3 +66,18 @@ def test_a_clip_with_a_moving_background_is_refused_naming_it(tmp_path, capsys):
 def test_a_missing_clip_is_refused(tmp_path, capsys):
     assert main(["resynth", str(tmp_path / "nothing"), "-o", str(tmp_path / "out"), "--frames", "2"]) == 2
     assert f"{tmp_path / 'nothing'}: no such video" in capsys.readouterr().err
+
+
+def test_a_clip_may_be_a_pattern_or_a_video(clip, tmp_path):
+    from fluidymation.stages.encode import Params, encode_mp4
+
+    folder = tmp_path / "folder"
+    assert main(["-q", "resynth", str(clip), "-o", str(folder), "--frames", "3", *QUICK]) == 0
+    pattern = tmp_path / "pattern"
+    assert main(["-q", "resynth", str(clip / "%04d.png"), "-o", str(pattern), "--frames", "3", *QUICK]) == 0
+    assert all(np.array_equal(a, b) for a, b in zip(_frames(pattern, 3), _frames(folder, 3)))
+    rgb, _ = sprite_clip(frames=5)
+    encode_mp4(list(rgb), tmp_path / "clip.mp4", params=Params(fps=12, crf=12))
+    video = tmp_path / "video"
+    assert main(["-q", "resynth", str(tmp_path / "clip.mp4"), "-o", str(video), "--frames", "3", *QUICK]) == 0
+    assert all(0.05 < (frame[..., 3] > 127).mean() < 0.2 for frame in _frames(video, 3))
