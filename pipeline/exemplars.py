@@ -75,6 +75,8 @@ def user_params(plan: Plan, name: str, spec: dict) -> exemplar_user.Params:
     if unsupported:
         raise SceneError(f"{where}.{unsupported[0]}: not an option of recorded exemplars; they take mask, flow, "
                          "scale, step, frames, reverse and seed")
+    if "segments" in spec and not Path(spec["segments"]).is_file():
+        raise SceneError(f"{where}.segments: {spec['segments']} is not a file")
     if spec.get("flow", "masks") == "exact":
         raise SceneError(f"{where}.flow: 'exact' is only known for built-in exemplars; use masks or motion")
     step = spec.get("step", 1)

@@ -14,6 +14,7 @@ and scaled.
 
 from __future__ import annotations
 
+import gc
 import warnings
 from dataclasses import dataclass
 from pathlib import Path
@@ -155,7 +156,7 @@ def _read_frames(spec: str) -> list[np.ndarray]:
 def _read_video(path: Path) -> list[np.ndarray]:
     import imageio_ffmpeg
 
-    frames = []
+    frames, error = [], None
     with warnings.catch_warnings():
         # imageio-ffmpeg leaves ffmpeg's stderr pipe for the garbage collector to close.
         warnings.simplefilter("ignore", ResourceWarning)
@@ -165,9 +166,12 @@ def _read_video(path: Path) -> list[np.ndarray]:
             for data in reader:
                 frames.append(np.frombuffer(data, dtype=np.uint8).reshape(height, width, 3).astype(np.float32) / 255.0)
         except (OSError, RuntimeError, StopIteration, KeyError, ValueError) as exc:
-            raise InputError(f"{path}: cannot decode the video ({exc})") from None
+            error = str(exc)  # raised below: this exception's traceback holds the ffmpeg process and its pipes
         finally:
             reader.close()
+        gc.collect()  # the pipes are closed here, where their ResourceWarning is ignored
+    if error is not None:
+        raise InputError(f"{path}: cannot decode the video ({error})")
     return frames
 
 

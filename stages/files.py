@@ -11,6 +11,7 @@ import glob
 import os
 import re
 import tempfile
+import warnings
 from pathlib import Path
 
 import imageio.v3 as iio
@@ -20,6 +21,7 @@ from fluidymation.errors import InputError
 
 
 _PRINTF = re.compile(r"%0?(\d*)d")
+MAX_IMAGE_PIXELS = 2**25  # 32 Mpx (8192 x 4096): an image read as float RGBA takes 512 MiB
 _UMASK = os.umask(0o022)
 os.umask(_UMASK)  # read once: written files get the mode a plain open() would give them, not mkstemp's 0600
 
@@ -98,6 +100,7 @@ def read_image(path: str | os.PathLike, *, channels: int | None = None) -> np.nd
     path = Path(path)
     if not path.is_file():
         raise InputError(f"{path}: no such file")
+    _check_declared_size(path)
     try:
         data = iio.imread(path)
     except Exception as exc:
@@ -111,6 +114,25 @@ def read_image(path: str | os.PathLike, *, channels: int | None = None) -> np.nd
     if channels is None:
         return image
     return _convert_channels(image, channels)
+
+
+def _check_declared_size(path: Path) -> None:
+    """An InputError when the image's header declares more than :data:`MAX_IMAGE_PIXELS` (checked before decoding;
+    files Pillow cannot open are left to imageio)."""
+    from PIL import Image
+
+    limit = f"over the limit of {MAX_IMAGE_PIXELS / 2**20:g} megapixels"
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", Image.DecompressionBombWarning)
+            with Image.open(path) as image:
+                width, height = image.size
+    except Image.DecompressionBombError:  # Pillow's own limit is above ours
+        raise InputError(f"{path}: the image's header declares a size {limit}") from None
+    except (OSError, ValueError, SyntaxError):
+        return
+    if width * height > MAX_IMAGE_PIXELS:
+        raise InputError(f"{path}: the image is {width}x{height} px, {limit}")
 
 
 def _convert_channels(image: np.ndarray, channels: int) -> np.ndarray:

@@ -17,6 +17,7 @@ from fluidymation.errors import InputError
 from fluidymation.stages.files import atomic_path
 
 FLO_TAG = b"PIEH"
+_NPY_HEADERS = {(1, 0): np.lib.format.read_array_header_1_0, (2, 0): np.lib.format.read_array_header_2_0}
 _FLO_UNKNOWN = 1e9
 
 
@@ -38,10 +39,7 @@ def read_flow(path: str | os.PathLike, *, shape: tuple[int, int] | None = None) 
         raise InputError(f"{path}: no such flow file")
     suffix = path.suffix.lower()
     if suffix == ".npy":
-        try:
-            flow = np.load(path, allow_pickle=False)
-        except (ValueError, OSError) as exc:
-            raise InputError(f"{path}: not a readable .npy array ({exc})") from None
+        flow = _read_npy(path, shape)
     elif suffix == ".flo":
         flow = _read_flo(path)
     else:
@@ -59,6 +57,32 @@ def read_flow(path: str | os.PathLike, *, shape: tuple[int, int] | None = None) 
     if not np.isfinite(flow).all():
         raise InputError(f"{path}: flow holds NaN or infinite values")
     return flow
+
+
+def _read_npy(path: Path, shape: tuple[int, int] | None) -> np.ndarray:
+    """The array of a ``.npy`` file, its header checked first: never a pickle (object arrays are refused before
+    any data is read), a float dtype, an (H, W, 2) shape (of ``shape`` if given) that the file's size holds."""
+    try:
+        with open(path, "rb") as handle:
+            version = np.lib.format.read_magic(handle)
+            if version not in _NPY_HEADERS:
+                raise ValueError(f"format version {version[0]}.{version[1]}; flows are read from 1.0 and 2.0")
+            dims, fortran, dtype = _NPY_HEADERS[version](handle)
+            offset = handle.tell()
+    except (ValueError, OSError, EOFError, SyntaxError) as exc:
+        raise InputError(f"{path}: not a readable .npy array ({exc})") from None
+    if dtype.hasobject or not np.issubdtype(dtype, np.floating):
+        raise InputError(f"{path}: a flow must hold floats in px/frame, got dtype {dtype}")
+    if len(dims) != 3 or dims[2] != 2 or min(dims) < 1:
+        raise InputError(f"{path}: a flow must have shape (H, W, 2) as (dx, dy), got {dims}")
+    if shape is not None and dims[:2] != tuple(shape):
+        raise InputError(f"{path}: flow has size {dims[1]}x{dims[0]} (W x H), the masks have {shape[1]}x{shape[0]}")
+    expected = offset + dims[0] * dims[1] * 2 * dtype.itemsize
+    if path.stat().st_size != expected:
+        raise InputError(f"{path}: the .npy header says {dims[1]}x{dims[0]}x2 {dtype} but the file has "
+                         f"{path.stat().st_size} bytes (expected {expected})")
+    flow = np.fromfile(path, dtype=dtype, offset=offset)
+    return flow.reshape(dims[::-1]).transpose() if fortran else flow.reshape(dims)
 
 
 def _read_flo(path: Path) -> np.ndarray:

@@ -23,6 +23,7 @@ from fluidymation.pipeline.presets import parse_size, preset_defaults, resolve_p
 from fluidymation.pipeline.progress import progress
 from fluidymation.stages import exemplar_builtin
 from fluidymation.stages.files import read_image, write_npy, write_png, write_text
+from fluidymation.stages.flow_io import read_flow
 
 
 def add_parser(subparsers) -> None:
@@ -105,23 +106,29 @@ def run_show(args) -> int:
         raise InputError(f"--count must be at least 1, got {args.count}")
     picks = sorted(set(np.linspace(0, len(frames) - 1, min(args.count, len(frames))).round().astype(int)))
     columns = []
+    images = {index: read_image(frames[index], channels=3) for index in picks}
+    size = images[picks[0]].shape[:2]
     flows = {}
     for index in picks:
+        if images[index].shape[:2] != size:
+            raise InputError(f"{frames[index]}: the frame is {images[index].shape[1]}x{images[index].shape[0]}, "
+                             f"{frames[picks[0]].name} is {size[1]}x{size[0]}; all frames must have one size")
         flow_path = folder / "flow" / f"{frames[index].stem}.npy"
         if flow_path.is_file():
-            flows[index] = np.load(flow_path)
+            flows[index] = read_flow(flow_path, shape=size)
     fastest = max([float(np.hypot(f[..., 0], f[..., 1]).max()) for f in flows.values()] + [1e-6])
     for index in picks:
-        rgb = read_image(frames[index], channels=3)
+        rgb = images[index]
         outlined = rgb.copy()
         mask_path = folder / "mask" / frames[index].name
         if mask_path.is_file():
             mask = read_image(mask_path, channels=1)[:, :, 0] > 0.5
+            if mask.shape != size:
+                raise InputError(f"{mask_path}: the mask is {mask.shape[1]}x{mask.shape[0]}, its frame "
+                                 f"{size[1]}x{size[0]}")
             outlined[mask & ~ndimage.binary_erosion(mask)] = (1.0, 0.0, 0.0)
         flow = flows.get(index)
         view = _flow_colours(flow, fastest) if flow is not None else np.zeros_like(rgb)
-        if view.shape != rgb.shape:
-            raise InputError(f"{flow_path}: flow of shape {flow.shape} does not match the frame {rgb.shape[:2]}")
         columns.append(np.concatenate([rgb, outlined, view], axis=0))
     gap = np.ones((columns[0].shape[0], 4, 3), dtype=np.float32)
     sheet = np.concatenate([part for column in columns for part in (column, gap)][:-1], axis=1)

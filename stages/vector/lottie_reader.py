@@ -34,6 +34,7 @@ from fluidymation.stages.vector.safety import (
 
 _PRECOMP, _TEXT = 0, 5
 _MAX_DENOMINATOR = 10**6
+_MAX_PATH_COORDINATE = 1e7  # px
 _IMAGE_TYPES = {"png": "image/png", "jpg": "image/jpeg", "jpeg": "image/jpeg", "webp": "image/webp",
                 "gif": "image/gif", "svg": "image/svg+xml"}
 _PLAYER_IMAGE_TYPES = {"image/png", "image/jpeg", "image/webp", "image/svg+xml"}
@@ -188,6 +189,8 @@ def _read_dotlottie(raw: bytes, path: Path, animation: str | None,
         archive = zipfile.ZipFile(io.BytesIO(raw))
     except zipfile.BadZipFile:
         raise InputError(f"{source}: not a dotLottie file (not a zip archive)") from None
+    except (NotImplementedError, UnicodeDecodeError) as exc:  # "zip file version 9.9", a member name not UTF-8
+        raise InputError(f"{source}: a zip archive Python's zipfile cannot read ({exc})") from None
     with archive:
         names = safe_zip_member_names(archive, source)
         manifest = _parse_json(read_zip_member(archive, "manifest.json", source), f"{source}:manifest.json") \
@@ -252,7 +255,8 @@ def _apply_theme(data: dict, theme: dict, name: str, animation: str) -> list[Uns
             continue
         if isinstance(rule.get("animations"), list) and animation not in rule["animations"]:
             continue
-        if rule.get("type") in _THEME_RULE_TYPES and ("value" in rule or isinstance(rule.get("keyframes"), list)):
+        if isinstance(rule.get("type"), str) and rule["type"] in _THEME_RULE_TYPES \
+                and ("value" in rule or isinstance(rule.get("keyframes"), list)):
             values[rule["id"]] = _theme_property(rule)
         else:
             skipped.append(Unsupported(f"theme '{name}' rules[{index}] '{rule['id']}'",
@@ -275,7 +279,7 @@ def _inline_slots(data: dict) -> None:
         node = stack.pop()
         children = node.values() if isinstance(node, dict) else node
         for child in children:
-            if isinstance(child, dict) and child.get("sid") in slots:
+            if isinstance(child, dict) and isinstance(child.get("sid"), str) and child["sid"] in slots:
                 value = slots[child["sid"]]
                 for key in ("a", "k"):
                     child.pop(key, None)
@@ -345,7 +349,8 @@ def _is_image(asset) -> bool:
 
 
 def _image_assets(data: dict) -> list[dict]:
-    return [asset for asset in data.get("assets") or [] if _is_image(asset)]
+    """The image assets of ``data`` (none when 'assets' is not a list: :func:`_check_structure` says so)."""
+    return [asset for asset in _list(data.get("assets")) if _is_image(asset)]
 
 
 def _check_structure(data: dict, source: str) -> None:
@@ -365,20 +370,34 @@ def _check_structure(data: dict, source: str) -> None:
         _check_references(asset, ("id",), f"assets[{index}]", source)
         if "layers" in asset:
             _check_layers(asset["layers"], f"assets[{index}].layers", source)
-    _check_no_null_items(data, source)
+    _check_items(data, source)
 
 
-def _check_no_null_items(data: dict, source: str) -> None:
+def _check_items(data: dict, source: str) -> None:
     """No ``null`` item in a list (a point, a colour, keyframes, shapes): no Lottie list holds one, and ThorVG 1.0
-    hangs loading some (a point's first coordinate, a keyframe)."""
+    hangs loading some (a point's first coordinate, a keyframe). No path coordinate beyond
+    :data:`_MAX_PATH_COORDINATE`: ThorVG 1.0 trims a path with a tangent of 2**31 for ever."""
     pending = [(data, "")]
     while pending:
         value, where = pending.pop()
         if isinstance(value, list) and None in value:
             raise InputError(f"{source}: not a valid Lottie animation: {where}[{value.index(None)}] is null")
+        if isinstance(value, dict) and all(key in value for key in ("v", "i", "o")):
+            _check_path_coordinates(value, where, source)
         for key, item in value.items() if isinstance(value, dict) else enumerate(value):
             if isinstance(item, (dict, list)):
                 pending.append((item, f"{where}[{key}]" if isinstance(key, int) else f"{where}.{key}".lstrip(".")))
+
+
+def _check_path_coordinates(path: dict, where: str, source: str) -> None:
+    """A bezier path's vertices and tangents (``v``, ``i``, ``o``) are finite and within :data:`_MAX_PATH_COORDINATE`."""
+    for key in ("v", "i", "o"):
+        for index, point in enumerate(_list(path[key])):
+            for axis, number in enumerate(_list(point)):
+                if isinstance(number, (int, float)) and not isinstance(number, bool) \
+                        and not abs(number) <= _MAX_PATH_COORDINATE:
+                    raise InputError(f"{source}: not a valid Lottie animation: {where}.{key}[{index}][{axis}] is "
+                                     f"{number!r}, beyond {_MAX_PATH_COORDINATE:g} px: it cannot be drawn")
 
 
 def _check_layers(layers, where: str, source: str) -> None:

@@ -10,8 +10,10 @@ from __future__ import annotations
 
 import gzip
 import io
+import lzma
 import re
 import zipfile
+import zlib
 from pathlib import Path, PurePosixPath
 from xml.etree import ElementTree
 
@@ -68,7 +70,7 @@ def gunzip_limited(data: bytes, source: str, *, limit: int = MAX_UNPACKED_BYTES)
     try:
         with gzip.GzipFile(fileobj=io.BytesIO(data)) as stream:
             out = stream.read(limit + 1)
-    except (OSError, EOFError) as exc:
+    except (OSError, EOFError, zlib.error) as exc:
         raise InputError(f"{source}: not valid gzip data ({exc})") from None
     if len(out) > limit:
         raise InputError(f"{source}: unpacks to more than {limit // 2**20} MiB; refused (a gzip bomb?)")
@@ -91,8 +93,18 @@ def safe_zip_member_names(archive: zipfile.ZipFile, source: str) -> list[str]:
 
 
 def read_zip_member(archive: zipfile.ZipFile, name: str, source: str) -> bytes:
-    with archive.open(name) as member:
-        data = member.read(MAX_UNPACKED_BYTES + 1)
+    """The bytes of member ``name``; an InputError when it is damaged, encrypted, compressed by an unknown method
+    or over :data:`MAX_UNPACKED_BYTES`."""
+    try:
+        with archive.open(name) as member:
+            data = member.read(MAX_UNPACKED_BYTES + 1)
+    except (zipfile.BadZipFile, zlib.error, lzma.LZMAError, OSError, EOFError, ValueError) as exc:
+        raise InputError(f"{source}: the archive member '{name}' is damaged ({exc})") from None
+    except NotImplementedError:
+        raise InputError(f"{source}: the archive member '{name}' is compressed by a method Python's zipfile does "
+                         "not read (use deflate)") from None
+    except RuntimeError as exc:  # zipfile's "File ... is encrypted, password required for extraction"
+        raise InputError(f"{source}: the archive member '{name}' cannot be read ({exc})") from None
     if len(data) > MAX_UNPACKED_BYTES:
         raise InputError(f"{source}: '{name}' unpacks to more than {MAX_UNPACKED_BYTES // 2**20} MiB; refused")
     return data

@@ -1,11 +1,14 @@
-"""The readers' fuzzing harness: mutate the project's own fixtures, run ``fluidymation check`` (and for a few
-``masks``) on each in-process, and judge the outcome.
+"""The readers' fuzzing harness: mutate the project's own fixtures, run the CLI on each case in-process, and judge
+the outcome. This module holds the scene, Lottie and SVG mutators and the running; tests/fuzz/packed.py and
+rasters.py the other readers', tests/fuzz/readers.py names them all.
 
-A case is the files of one tmp folder (``scene.yaml`` and its input) and the CLI arguments. The property:
-exit code 0 or 2; with 2, stderr has an ``error:`` line naming the scene or its input; never exit 1 (internal
-error) nor an uncaught exception; under :data:`TIME_LIMIT` seconds; nothing written outside the case's folder.
-Mutators take a :class:`random.Random` so the pytest subset (hypothesis ``randoms()``) and the long run
-(``python -m tests.fuzz``) share them.
+A case is the files of one tmp folder (``scene.yaml`` and its inputs) and the CLI arguments. The property:
+exit code 0 or 2; with 2, stderr has an ``error:`` line naming the scene or one of its files; never exit 1
+(internal error) nor an uncaught exception; under :data:`TIME_LIMIT` seconds; a peak resident size under
+:data:`RSS_LIMIT`; nothing written outside the case's folder, nothing read outside it, the package, Python and the
+system's files (audited with :func:`sys.addaudithook`, :data:`BAIT` files lie beside the folder), nothing
+unpickled and no network access. Mutators take a :class:`random.Random` so the pytest subset (hypothesis
+``randoms()``) and the long run (``python -m tests.fuzz``) share them.
 """
 
 from __future__ import annotations
@@ -17,6 +20,7 @@ import json
 import os
 import random
 import re
+import resource
 import sys
 import time
 import traceback
@@ -28,6 +32,7 @@ import yaml
 
 ROOT = Path(__file__).parents[2]
 TIME_LIMIT = 20.0
+RSS_LIMIT = 2 * 2**30  # bytes: the peak resident size a case may reach
 SMALL = {"size": [32, 32], "frames": {"start": 0, "end": 2}}
 
 # ---------------------------------------------------------------------------------------------- seeds
@@ -153,13 +158,14 @@ def truncate(rng: random.Random, data: bytes) -> bytes:
 
 @dataclass
 class Case:
-    """The files of one case (name → bytes, under its tmp folder), the CLI arguments (``{scene}`` is replaced
-    by the scene's path) and what it is, for reports."""
+    """The files of one case (relative path → bytes, under its tmp folder), the CLI arguments (``{scene}`` is
+    replaced by the scene's path, ``{case}`` by the folder's) and what it is, for reports."""
     reader: str
     label: str
     files: dict[str, bytes]
     argv: list[str] = field(default_factory=lambda: ["-q", "check", "{scene}"])
     input_name: str | None = None
+    names: tuple[str, ...] = ()  # more that an error may name: patterns, folders
 
 
 def small_scene(input_name: str, extra: dict | None = None) -> bytes:
@@ -285,7 +291,7 @@ def svg_case(rng: random.Random, seeds=None, masks: bool = False) -> Case:
         argv = ["-q", "masks", "{scene}", "--frames", "0:1"]
         first = first_layer(text)
         if first:
-            argv += ["--layer", first]
+            argv.append(f"--layer={first}")  # a name may start with "-"
     return Case("svg", label, {"anim.svg": text, "scene.yaml": small_scene("anim.svg")}, argv, "anim.svg")
 
 
@@ -301,28 +307,37 @@ def first_layer(text: bytes) -> str | None:
     return None
 
 
-MAKERS = {"scene": scene_case, "lottie": lottie_case, "svg": svg_case}
-
 # ---------------------------------------------------------------------------------------------- running
 
 
 @dataclass
 class Outcome:
+    """How a case ended: exit code, output, time, and what the audit hook and the resident size saw."""
     code: int | None
     stdout: str
     stderr: str
     seconds: float
-    exception: BaseException | None = None
+    exception: str | None = None  # "Type: message" of an exception that escaped main()
     stray_writes: list[str] = field(default_factory=list)
+    stray_reads: list[str] = field(default_factory=list)
+    forbidden: list[str] = field(default_factory=list)  # unpickling, network access
+    peak_rss: int = 0  # bytes, the process's peak resident size after the case
+    rss_before: int = 0  # bytes, the peak before it
 
     def problem(self, case: Case, folder: Path) -> str | None:
         """What breaks the property, or None."""
         if self.exception is not None:
-            return f"uncaught {type(self.exception).__name__}: {self.exception}"
+            return f"uncaught {self.exception}"
+        if self.forbidden:
+            return f"forbidden: {self.forbidden[:3]}"
         if self.seconds > TIME_LIMIT:
             return f"took {self.seconds:.1f} s (limit {TIME_LIMIT:g} s)"
+        if self.peak_rss > RSS_LIMIT and self.peak_rss > self.rss_before:
+            return f"resident size reached {self.peak_rss / 2**20:.0f} MiB (limit {RSS_LIMIT / 2**20:.0f} MiB)"
         if self.stray_writes:
             return f"wrote outside its folder: {self.stray_writes[:3]}"
+        if self.stray_reads:
+            return f"read outside its folder: {self.stray_reads[:3]}"
         if self.code not in (0, 2):
             return f"exit {self.code}: {first_line(self.stderr)}"
         if self.code == 2:
@@ -332,20 +347,34 @@ class Outcome:
             if not lines:
                 return f"exit 2 without an 'error:' line: {first_line(self.stderr)}"
             message = self.stderr[self.stderr.index("error:"):]
-            names = {"scene.yaml", *([case.input_name] if case.input_name else []), *_named_input(case)}
-            if not any(name in message for name in names):
+            if not any(name in message for name in case_names(case)):
                 return f"error names no file: {first_line(message)}"
         return None
 
 
+def case_names(case: Case) -> set[str]:
+    """What an error about ``case`` may name: the scene, its input, the case's files (path or name), its extra
+    ``names`` (patterns, folders)."""
+    files = {name for path in case.files for name in (path, Path(path).name)}
+    return {"scene.yaml", *([case.input_name] if case.input_name else []), *_named_input(case), *files, *case.names}
+
+
 def _named_input(case: Case) -> list[str]:
-    """The ``input:`` a (mutated) scene names, as written and as its file name: an error may name it."""
+    """The ``input:`` a (mutated) scene names, as written and as its file name, and the file names of the other
+    paths it names (an exemplar's, in any form): an error may name them."""
     try:
         scene = yaml.safe_load(case.files.get("scene.yaml", b""))
     except (yaml.YAMLError, RecursionError, ValueError):
         return []
-    value = scene.get("input") if isinstance(scene, dict) else None
-    return [str(value), Path(str(value)).name] if isinstance(value, str) and value.strip() else []
+    if not isinstance(scene, dict):
+        return []
+    value = scene.get("input")
+    named = [str(value), Path(str(value)).name] if isinstance(value, str) and value.strip() else []
+    exemplars = scene.get("exemplars")
+    for _, text in nodes(exemplars if isinstance(exemplars, dict) else {}):
+        if isinstance(text, str) and Path(text).name.strip():
+            named.append(Path(text).name)
+    return named
 
 
 def first_line(text: str) -> str:
@@ -355,72 +384,124 @@ def first_line(text: str) -> str:
     return text.strip()[:300]
 
 
-_watch: dict = {"folder": None, "stray": None}
+_watch: dict = {"folder": None}
 _TMPFILE = getattr(os, "O_TMPFILE", -1) & ~os.O_DIRECTORY if hasattr(os, "O_TMPFILE") else 1 << 40
-_ALLOWED = [os.devnull, "/dev/", "/proc/"]
+_WRITABLE = [os.devnull, "/dev/", "/proc/"]
+#: Besides the case's folder and the user cache: the package and its fixtures, Python, the venv, the numba
+#: cache, and the system's own files.
+_READABLE = [*(f"{ROOT / name}/" for name in ("fluidymation", "pipeline", "stages", "engine", "configs", "tests",
+                                              "examples", "fluidymation.egg-info")),
+             f"{sys.prefix}/", f"{sys.base_prefix}/", "/proc/", "/dev/", "/usr/", "/etc/"]
+_NETWORK = ("socket.connect", "socket.getaddrinfo", "urllib.Request")
+
+
+def _numba_cache() -> str:
+    return os.environ.get("NUMBA_CACHE_DIR", str(ROOT / ".numba-cache")) + "/"
+
+
+def _numba_caching() -> bool:
+    """Whether numba is the caller: it unpickles its own cache of compiled functions."""
+    frame = sys._getframe(2)
+    while frame is not None:
+        if frame.f_code.co_filename.endswith(("numba/core/caching.py", "numba/core/serialize.py")):
+            return True
+        frame = frame.f_back
+    return False
 
 
 def _audit(event, args):
-    if event != "open" or _watch["folder"] is None:
+    if _watch["folder"] is None:
         return
-    path, mode, flags = args
+    if event == "pickle.find_class" and not _numba_caching():
+        _watch["forbidden"].append(f"unpickled {args[0]}.{args[1]}")
+    elif event in _NETWORK:
+        _watch["forbidden"].append(f"{event} {str(args[1])[:80]}")
+    elif event == "open":
+        _audit_open(*args)
+
+
+def _audit_open(path, mode, flags):
+    """Note a file written or read outside the places a case may use."""
+    if not isinstance(path, (str, bytes, os.PathLike)):
+        return  # a file descriptor
     writing = (isinstance(mode, str) and any(c in mode for c in "wax+")) or \
         (isinstance(flags, int) and flags & (os.O_WRONLY | os.O_RDWR | os.O_CREAT | os.O_APPEND))
-    if not writing or not isinstance(path, (str, bytes, os.PathLike)):
-        return
-    if isinstance(flags, int) and flags & _TMPFILE == _TMPFILE:
+    if writing and isinstance(flags, int) and flags & _TMPFILE == _TMPFILE:
         return  # tempfile.TemporaryFile: an anonymous file, nothing named is left behind
     path = os.path.abspath(os.fsdecode(path))
-    allowed = [str(_watch["folder"]), os.environ.get("NUMBA_CACHE_DIR", str(ROOT / ".numba-cache")), *_ALLOWED]
-    if not any(path.startswith(prefix) for prefix in allowed):
-        _watch["stray"].append(path)
+    inside = [_watch["folder"], _numba_cache()]
+    if writing:
+        _watch["written"].add(path)
+        if not any(path.startswith(prefix) for prefix in inside + _WRITABLE):
+            _watch["stray"].append(path)
+    elif not any(path.startswith(prefix) for prefix in inside + _READABLE + [_watch["cache"]]) \
+            and path not in _watch["written"] and os.path.isfile(path):
+        _watch["reads"].append(path)  # a folder opened by name (os.scandir, rmtree) reads nothing
 
 
 sys.addaudithook(_audit)
 
+#: Files beside each case's folder that no reader may open (a path traversal would): ``../secret.*``.
+BAIT = {"secret.png": b"\x89PNG\r\n\x1a\nbait", "secret.json": b'{"bait": 1}', "secret.svg": b"<svg/>"}
+
+
+def _peak_rss() -> int:
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
+
 
 def run_case(case: Case, folder: Path, debug: bool = False) -> Outcome:
-    """Write ``case`` into ``folder`` and run the CLI on it in-process, cwd and user cache in ``folder``."""
+    """Write ``case`` into ``folder/case`` (:data:`BAIT` beside it) and run the CLI on it in-process, cwd and user
+    cache in that folder."""
+    from fluidymation.pipeline import paths
     from fluidymation.pipeline.cli import main
 
-    folder.mkdir(parents=True, exist_ok=True)
-    for name, data in case.files.items():
+    root = folder / "case"
+    root.mkdir(parents=True, exist_ok=True)
+    for name, data in BAIT.items():
         (folder / name).write_bytes(data)
-    argv = [arg.replace("{scene}", str(folder / "scene.yaml")) for arg in case.argv] + (["--debug"] if debug else [])
+    for name, data in case.files.items():
+        (root / name).parent.mkdir(parents=True, exist_ok=True)
+        (root / name).write_bytes(data)
+    argv = [arg.replace("{scene}", str(root / "scene.yaml")).replace("{case}", str(root)) for arg in case.argv]
+    argv += ["--debug"] if debug else []
     out, err = io.StringIO(), io.StringIO()
     old_cwd, old_cache = os.getcwd(), os.environ.get("FLUIDYMATION_CACHE")
-    os.environ["FLUIDYMATION_CACHE"] = str(folder / "cache")
-    os.chdir(folder)
-    _watch.update(folder=folder.resolve(), stray=[])
+    os.environ["FLUIDYMATION_CACHE"] = str(root / "cache")
+    os.chdir(root)
+    _watch.update(folder=f"{root.resolve()}/", cache=f"{paths.cache_dir().resolve()}/", stray=[], reads=[],
+                  written=set(), forbidden=[])
+    rss_before = _peak_rss()
     start = time.perf_counter()
     code, exception = None, None
     try:
         with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
             code = main(argv)
     except BaseException as exc:  # the property: nothing escapes main()
-        exception = exc
+        exception = f"{type(exc).__name__}: {exc}"[:500]
         err.write(traceback.format_exc())
     finally:
         seconds = time.perf_counter() - start
         # temporary files (tempfile's probes, a worker's stderr) are gone by now: what is left was written
         stray = [path for path in dict.fromkeys(_watch["stray"]) if os.path.isfile(path)]
-        _watch.update(folder=None, stray=None)
+        reads, forbidden = list(dict.fromkeys(_watch["reads"])), _watch["forbidden"]
+        _watch.update(folder=None)
         os.chdir(old_cwd)
         if old_cache is None:
             os.environ.pop("FLUIDYMATION_CACHE", None)
         else:
             os.environ["FLUIDYMATION_CACHE"] = old_cache
-    return Outcome(code, out.getvalue(), err.getvalue(), seconds, exception, stray)
+    return Outcome(code, out.getvalue(), err.getvalue(), seconds, exception, stray, reads, forbidden, _peak_rss(),
+                   rss_before)
 
 
 def signature(case: Case, outcome: Outcome, folder: Path) -> str:
     """A failure's identity: exit code, exception type and where it was raised (from a ``--debug`` rerun)."""
-    kind = type(outcome.exception).__name__ if outcome.exception else ""
+    kind = outcome.exception.split(":", 1)[0] if outcome.exception else ""
     where = ""
     if outcome.code == 1 or outcome.exception:
         rerun = run_case(case, folder / "debug", debug=True) if outcome.exception is None else outcome
         frames = re.findall(r'File "([^"]+)", line (\d+), in (\w+)', rerun.stderr)
-        ours = [f for f in frames if "/work/main/" in f[0] and "/.venv/" not in f[0]] or frames
+        ours = [f for f in frames if f[0].startswith(str(ROOT)) and "/.venv/" not in f[0]] or frames
         if ours:
             where = f"{Path(ours[-1][0]).relative_to(ROOT) if ours[-1][0].startswith(str(ROOT)) else ours[-1][0]}:{ours[-1][1]}"
         match = re.search(r"^(\w+(?:\.\w+)*(?:Error|Exception|Warning|Exit)\w*):", rerun.stderr, re.M)

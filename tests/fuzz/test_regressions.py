@@ -1,10 +1,18 @@
 """What the readers' fuzzing found (tests/fuzz/harness.py), one small case each: exit code 2 with a message naming
-the file and the key or element, where each used to be an internal error (exit 1)."""
+the file and the key, element or member (or success), where each used to be an internal error (exit 1), a hang or
+an unbounded use of memory."""
 
+import gzip
+import io
 import json
+import pickle
 
+import imageio.v3 as iio
+import numpy as np
 import pytest
 
+from tests.fuzz.packed import _bomb_zip, _encrypted, _members, _method, _zip
+from tests.fuzz.rasters import _fixed_crc, exemplar_seeds, large_png
 from tests.scenes import ROOT, blob_scene, write_scene
 
 LOTTIE = ROOT / "examples/wave/wave.json"
@@ -116,3 +124,195 @@ def test_svg_radius_beyond_reason(tmp_path, svg):  # cairo's arc looped for ever
                           capture_output=True, text=True, timeout=60)
     assert done.returncode == 2, done.stderr
     assert "huge.svg" in done.stderr and 'ry="' in done.stderr and "radius beyond" in done.stderr, done.stderr
+
+
+def _dotlottie(tmp_path, archive: bytes):
+    (tmp_path / "anim.lottie").write_bytes(archive)
+    return write_scene(tmp_path, "input: anim.lottie\nsize: [32, 32]\nframes: {start: 0, end: 2}\n")
+
+
+@pytest.mark.parametrize("damage,fragment", [(lambda data: _method(data, 99), "compressed by a method"),
+                                             (_encrypted, "is encrypted"),
+                                             (lambda data: _bomb_zip("animations/anim.json", declared=10), "damaged")])
+def test_dotlottie_member_unreadable(cli, tmp_path, damage, fragment):  # were NotImplementedError, RuntimeError,
+    # BadZipFile (bad CRC) and zlib.error from zipfile (stages/vector/safety.py read_zip_member)
+    archive = damage((ROOT / "tests/data/lottie/precomp.lottie").read_bytes())
+    refused(cli, _dotlottie(tmp_path, archive), "anim.lottie", "archive member", fragment)
+
+
+def test_tgs_corrupt_deflate_stream(cli, tmp_path):  # was zlib.error from gzip (stages/vector/safety.py)
+    data = bytearray(gzip.compress(b'{"v": "5.5.2", "layers": []}' * 50, mtime=0))
+    data[12:16] = b"\xff\xff\xff\xff"
+    (tmp_path / "anim.tgs").write_bytes(bytes(data))
+    write_scene(tmp_path, "input: anim.tgs\n")
+    refused(cli, tmp_path / "scene.yaml", "anim.tgs", "not valid gzip data")
+
+
+def _npy_bytes(array: np.ndarray, allow_pickle: bool = False) -> bytes:
+    buffer = io.BytesIO()
+    np.save(buffer, array, allow_pickle=allow_pickle)
+    return buffer.getvalue()
+
+
+def _npz_bytes(array: np.ndarray) -> bytes:
+    buffer = io.BytesIO()
+    np.savez(buffer, flow=array)
+    return buffer.getvalue()
+
+
+def _npy_header_shape(flow: np.ndarray, shape: str) -> bytes:
+    """``flow`` as .npy bytes whose header claims ``shape``."""
+    return _npy_bytes(flow).replace(str(flow.shape).encode(), shape.encode(), 1)
+
+
+FLOW = np.zeros((24, 24, 2), np.float32)
+
+
+@pytest.mark.parametrize("content,fragment", [
+    (pickle.dumps([print]), "not a readable .npy array"),  # was ValueError from np.load (pickled data)
+    (_npy_bytes(np.array([print], dtype=object), allow_pickle=True), "got dtype object"),  # ValueError: object arrays
+    (_npy_header_shape(FLOW, "(99999, 99999, 2)"), "the masks have 24x24"),  # was MemoryError
+    (_npy_header_shape(FLOW, "(24, 24, 2, 1)"), "must have shape (H, W, 2)"),  # was IndexError in _flow_colours
+    (_npy_bytes(FLOW.astype(np.complex64)), "must hold floats"),  # was TypeError (hypot of complex)
+    (_npy_bytes(FLOW)[:-7], "the file has"),  # was ValueError: failed to read all data
+    (_npz_bytes(FLOW), "not a readable .npy array"),  # was KeyError / AttributeError: an NpzFile
+])
+def test_exemplar_show_flow_files(cli, tmp_path, content, fragment):  # np.load was unchecked in exemplar show
+    for folder in ("rgb", "mask", "flow"):
+        (tmp_path / "ex" / folder).mkdir(parents=True)
+    iio.imwrite(tmp_path / "ex/rgb/00000.png", np.full((24, 24, 3), 200, np.uint8))
+    iio.imwrite(tmp_path / "ex/mask/00000.png", np.full((24, 24), 255, np.uint8))
+    (tmp_path / "ex/flow/00000.npy").write_bytes(content)
+    code, _, err = cli("-q", "exemplar", "show", tmp_path / "ex", "-o", tmp_path / "sheet.png")
+    assert code == 2 and "00000.npy" in err and fragment in err and "Traceback" not in err, err
+
+
+def test_exemplar_show_mask_of_another_size(cli, tmp_path):  # was IndexError (boolean index)
+    for folder in ("rgb", "mask"):
+        (tmp_path / "ex" / folder).mkdir(parents=True)
+    iio.imwrite(tmp_path / "ex/rgb/00000.png", np.full((24, 24, 3), 200, np.uint8))
+    iio.imwrite(tmp_path / "ex/mask/00000.png", np.full((1, 24), 255, np.uint8))
+    code, _, err = cli("-q", "exemplar", "show", tmp_path / "ex", "-o", tmp_path / "sheet.png")
+    assert code == 2 and "mask/00000.png" in err and "the mask is 24x1" in err, err
+
+
+@pytest.mark.parametrize("content", [_npz_bytes(np.zeros((32, 32, 2), np.float32)),  # was AttributeError: NpzFile
+                                     _npy_header_shape(np.zeros((32, 32, 2), np.float32), "(99999, 99999, 2)")])
+def test_guides_given_flow_npy(cli, tmp_path, content):  # the latter was MemoryError in np.load
+    (tmp_path / "flow").mkdir()
+    for index in range(2):
+        (tmp_path / "flow" / f"{index:05d}.npy").write_bytes(content)
+    scene = write_scene(tmp_path, f"input: {ROOT / 'examples/blob/blob.svg'}\nsize: [32, 32]\n"
+                                  "frames: {start: 0, end: 2}\nlayers:\n  - {name: blob, select: [blob]}\n")
+    code, _, err = cli("-q", "guides", scene, "--layer", "blob", "--flow", tmp_path / "flow/%05d.npy")
+    assert code == 2 and "00000.npy" in err and "Traceback" not in err, err
+
+
+def test_exemplar_segments_that_are_no_file(cli, tmp_path):  # was FileNotFoundError in pipeline/exemplars.py
+    iio.imwrite(tmp_path / "still.png", np.full((24, 24, 3), 200, np.uint8))
+    scene = blob_scene(size=32, frames=(0, 1)).replace(
+        "  ink: {builtin", "  still: {image: still.png, segments: '*'}\n  ink: {builtin")
+    scene = scene.replace("exemplar: ink", "exemplar: still")
+    code, _, err = cli("-q", "render", write_scene(tmp_path, scene), "--until", "stylize")
+    assert code == 2 and "exemplars.still.segments" in err and "is not a file" in err, err
+
+
+def test_exemplar_pattern_matching_a_folder(cli, tmp_path):  # a folder matched by mask: '*' was read as an image
+    (tmp_path / "rec").mkdir()
+    iio.imwrite(tmp_path / "rec/00.png", np.full((24, 24, 3), 200, np.uint8))
+    (tmp_path / "masks/sub.png").mkdir(parents=True)
+    iio.imwrite(tmp_path / "masks/00.png", np.full((24, 24), 255, np.uint8))
+    scene = blob_scene(size=32, frames=(0, 1)).replace(
+        "  ink: {builtin", "  rec: {images: rec, mask: 'masks/*.png'}\n  ink: {builtin")
+    code, _, err = cli("-q", "render", write_scene(tmp_path, scene.replace("exemplar: ink", "exemplar: rec")),
+                       "--until", "stylize")
+    assert code == 0, err
+
+
+def _with_header_size(png: bytes, width: int, height: int) -> bytes:
+    data = bytearray(png)
+    data[16:24] = width.to_bytes(4, "big") + height.to_bytes(4, "big")
+    return bytes(_fixed_crc(data))
+
+
+@pytest.mark.parametrize("declared", [False, True])
+def test_exemplar_image_too_large(cli, tmp_path, declared):  # a 12000² PNG took 199 s and 18 GB resident
+    image = large_png() if not declared else _with_header_size(iio.imwrite("<bytes>", np.zeros((4, 4), np.uint8),
+                                                                            extension=".png"), 65536, 65536)
+    (tmp_path / "still.png").write_bytes(image)
+    scene = blob_scene(size=32, frames=(0, 1)).replace(
+        "  ink: {builtin", "  still: {image: still.png, mask: full}\n  ink: {builtin")
+    code, _, err = cli("-q", "render", write_scene(tmp_path, scene.replace("exemplar: ink", "exemplar: still")),
+                       "--until", "stylize")
+    assert code == 2 and "still.png" in err and "over the limit of 32 megapixels" in err, err
+
+
+def test_dotlottie_zip_of_an_unknown_version(cli, tmp_path):  # was NotImplementedError from zipfile.ZipFile
+    archive = bytearray((ROOT / "tests/data/lottie/precomp.lottie").read_bytes())
+    central = archive.find(b"PK\x01\x02")
+    archive[central + 6] = 230  # "version needed to extract": 23.0
+    refused(cli, _dotlottie(tmp_path, bytes(archive)), "anim.lottie", "zipfile cannot read", "version 23.0")
+
+
+def test_dotlottie_assets_that_are_no_list(cli, tmp_path):  # was TypeError in lottie_reader.py _image_assets
+    animation = json.loads((ROOT / "tests/data/lottie/precomp.json").read_text())
+    animation["assets"] = 1
+    archive = _zip({"manifest.json": b'{"animations": [{"id": "anim"}]}',
+                    "animations/anim.json": json.dumps(animation).encode()})
+    refused(cli, _dotlottie(tmp_path, archive), "anim.lottie", "'assets' must be a list of objects")
+
+
+def test_lottie_slot_id_that_is_a_list(cli, tmp_path):  # was TypeError: unhashable (lottie_reader.py _inline_slots)
+    data = json.loads(LOTTIE.read_text())
+    data["slots"] = {"colour": {"p": {"a": 0, "k": [1, 0, 0, 1]}}}
+    data["layers"][0]["ks"]["o"]["sid"] = ["colour"]
+    (tmp_path / "anim.json").write_text(json.dumps(data))
+    write_scene(tmp_path, "input: anim.json\nsize: [32, 32]\nframes: {start: 0, end: 2}\n")
+    code, out, err = cli("-q", "check", tmp_path / "scene.yaml")
+    assert code == 0, err
+
+
+def test_lottie_path_tangent_beyond_reason(tmp_path):  # ThorVG trimmed the path for ever: exit 2 after 60 s
+    import subprocess
+    import sys
+
+    data = json.loads((ROOT / "tests/data/lottie/trim_path.json").read_text())
+    data["layers"][0]["shapes"][0]["it"][0]["ks"]["k"]["o"][0][1] = 2**31
+    (tmp_path / "anim.json").write_text(json.dumps(data))
+    write_scene(tmp_path, "input: anim.json\nsize: [32, 32]\nframes: {start: 0, end: 2}\n")
+    done = subprocess.run([sys.executable, "-m", "fluidymation", "-q", "check", str(tmp_path / "scene.yaml")],
+                          capture_output=True, text=True, timeout=60)
+    assert done.returncode == 2, done.stderr
+    assert "anim.json" in done.stderr and "layers[0].shapes[0].it[0].ks.k.o[0][1] is 2147483648" in done.stderr
+
+
+def test_dotlottie_theme_rule_type_that_is_a_list(cli, tmp_path):  # was TypeError: unhashable (_apply_theme)
+    members = _members((ROOT / "tests/data/lottie/themed.lottie").read_bytes())
+    theme = json.loads(members["t/moved.json"])
+    theme["rules"][0]["type"] = ["Color"]
+    members["t/moved.json"] = json.dumps(theme).encode()
+    code, out, err = cli("-q", "check", _dotlottie(tmp_path, _zip(members)))
+    assert code == 0 and "a rule of type ['Color'], which is not applied" in err, err
+
+
+def test_recorded_video_that_cannot_be_decoded(cli, tmp_path):  # ffmpeg's pipes were left open (ResourceWarning)
+    (tmp_path / "rec.mp4").write_bytes(exemplar_seeds()["mp4"][:200])
+    scene = blob_scene(size=32, frames=(0, 1)).replace(
+        "  ink: {builtin", "  rec: {video: rec.mp4, mask: full}\n  ink: {builtin")
+    code, _, err = cli("-q", "render", write_scene(tmp_path, scene.replace("exemplar: ink", "exemplar: rec")),
+                       "--until", "stylize")
+    assert code == 2 and "rec.mp4: cannot decode the video" in err, err
+
+
+def test_dotlottie_member_name_not_utf8(cli, tmp_path):  # was UnicodeDecodeError from zipfile.ZipFile
+    archive = _zip({"manifest.json": b"{}", "animations/an\u00efm.json": LOTTIE.read_bytes()})
+    archive = archive.replace("\u00ef".encode(), b"\xb0\xaf")  # the names' UTF-8 flag stays set
+    refused(cli, _dotlottie(tmp_path, archive), "anim.lottie", "zipfile cannot read", "can't decode byte 0xb0")
+
+
+def test_dotlottie_central_directory_offset_too_large(cli, tmp_path):  # was ValueError (negative seek) in zipfile
+    archive = bytearray((ROOT / "tests/data/lottie/precomp.lottie").read_bytes())
+    end = archive.rfind(b"PK\x05\x06")
+    offset = int.from_bytes(archive[end + 16:end + 20], "little") + 4_000_000
+    archive[end + 16:end + 20] = offset.to_bytes(4, "little")
+    refused(cli, _dotlottie(tmp_path, bytes(archive)), "anim.lottie", "archive member", "negative seek value")
