@@ -108,7 +108,7 @@ class Checker:
         if data is None:
             return _absent(self, path, default)
         if not isinstance(data, str) or not data:
-            raise self.error(path, f"expected text, got {_describe(data)}")
+            raise self.error(path, f"expected text, got {'empty text' if data == '' else _describe(data)}")
         if choices is not None and data not in choices:
             raise self.error(path, f"'{data}' is not one of {', '.join(choices)}{_suggest(data, choices)}")
         return data

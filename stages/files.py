@@ -99,7 +99,7 @@ def read_image(path: str | os.PathLike, *, channels: int | None = None) -> np.nd
     """
     path = Path(path)
     if not path.is_file():
-        raise InputError(f"{path}: no such file")
+        raise InputError(f"{path}: {'a folder, not an image file' if path.is_dir() else 'no such file'}")
     _check_declared_size(path)
     try:
         data = iio.imread(path)

@@ -316,3 +316,11 @@ def test_dotlottie_central_directory_offset_too_large(cli, tmp_path):  # was Val
     offset = int.from_bytes(archive[end + 16:end + 20], "little") + 4_000_000
     archive[end + 16:end + 20] = offset.to_bytes(4, "little")
     refused(cli, _dotlottie(tmp_path, bytes(archive)), "anim.lottie", "archive member", "negative seek value")
+
+
+def test_an_image_path_that_is_a_folder_is_named_as_a_folder(tmp_path):
+    from fluidymation.errors import InputError
+    from fluidymation.stages.files import read_image
+
+    with pytest.raises(InputError, match="a folder, not an image file"):
+        read_image(tmp_path)

@@ -157,6 +157,7 @@ def test_impossible_sizes_and_ranges(cli, tmp_path, extra, fragment):
 @pytest.mark.parametrize("extra,fragment", [
     ("animation: second\n", "picks an animation or theme of a dotLottie archive"),
     ("theme: [dark]\n", "theme: expected text"),
+    ("theme: ''\n", "theme: expected text, got empty text"),
 ])
 def test_dotlottie_choices_on_other_inputs(cli, tmp_path, extra, fragment):
     shutil.copy(DATA / "matte.json", tmp_path / "m.json")
