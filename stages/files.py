@@ -111,6 +111,9 @@ def read_image(path: str | os.PathLike, *, channels: int | None = None) -> np.nd
         raise InputError(f"{path}: expected a single image, got an array of shape {data.shape}")
     scale = float(np.iinfo(data.dtype).max) if np.issubdtype(data.dtype, np.integer) else 1.0
     image = data.astype(np.float32) / np.float32(scale)
+    if not np.isfinite(image).all():  # a floating-point image (TIFF, EXR) with NaN or infinite values
+        raise InputError(f"{path}: the image holds values that are not finite numbers (NaN or infinity)")
+    image = np.clip(image, 0.0, 1.0)  # floating-point images may stray outside [0, 1]
     if channels is None:
         return image
     return _convert_channels(image, channels)

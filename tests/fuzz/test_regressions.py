@@ -324,3 +324,27 @@ def test_an_image_path_that_is_a_folder_is_named_as_a_folder(tmp_path):
 
     with pytest.raises(InputError, match="a folder, not an image file"):
         read_image(tmp_path)
+
+
+@pytest.mark.parametrize("value", [np.nan, np.inf])
+def test_a_float_image_with_non_finite_values_is_refused_naming_it(tmp_path, value):
+    """A float TIFF under a PNG name (imageio reads it by its content through Pillow)."""
+    from PIL import Image
+
+    from fluidymation.errors import InputError
+    from fluidymation.stages.files import read_image
+
+    values = np.full((4, 4), 0.5, np.float32)
+    values[1, 2] = value
+    Image.fromarray(values, mode="F").save(tmp_path / "seg.png", format="TIFF")
+    with pytest.raises(InputError, match="seg.png: the image holds values that are not finite"):
+        read_image(tmp_path / "seg.png", channels=4)
+
+
+def test_a_float_image_beyond_one_is_clipped(tmp_path):
+    from PIL import Image
+
+    from fluidymation.stages.files import read_image
+
+    Image.fromarray(np.array([[2.0, -1.0]], np.float32), mode="F").save(tmp_path / "bright.png", format="TIFF")
+    assert read_image(tmp_path / "bright.png").ravel().tolist() == [1.0, 0.0]
