@@ -24,6 +24,7 @@ import numpy as np
 import yaml
 
 from fluidymation.errors import InputError
+from fluidymation.pipeline.panels import over_paper
 from fluidymation.pipeline.parameters import build_params, default_params
 from fluidymation.pipeline.progress import progress, reporter
 from fluidymation.stages import cartoon, encode, exemplar_user
@@ -104,7 +105,7 @@ def run(args) -> int:
             _save_state(state, frame)
             bar.update()
     video = out / "resynth.mp4"
-    encode.encode_mp4((_over(read_image(out / "frames" / f"{index:04d}.png", channels=4), recording.paper)
+    encode.encode_mp4((over_paper(read_image(out / "frames" / f"{index:04d}.png", channels=4), recording.paper)
                        for index in range(args.frames)), video, params=encode.Params(fps=args.fps))
     if not args.quiet:
         print(f"wrote {args.frames} frames to {out / 'frames'} and {video}")
@@ -158,7 +159,3 @@ def _resumed(state: Path) -> cartoon.CartoonFrame | None:
     with np.load(state / "last.npz") as stored:
         return cartoon.CartoonFrame(int(stored["index"]), stored["rgba"], NNF(stored["frame"], stored["coords"]),
                                     stored["history"])
-
-
-def _over(rgba: np.ndarray, paper: np.ndarray) -> np.ndarray:
-    return rgba[..., :3] * rgba[..., 3:] + paper[None, None, :] * (1.0 - rgba[..., 3:])
