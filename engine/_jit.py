@@ -18,9 +18,11 @@ import numba
 from llvmlite import binding as llvm
 from llvmlite import ir
 from numba import types
-from numba.core import caching, cgutils, codegen
+from numba.core import caching, cgutils, codegen, event
 from numba.core.dispatcher import Dispatcher
 from numba.extending import intrinsic
+
+from fluidymation.engine import compiling
 
 
 def _optimize_with_own_copies(library, _optimize=codegen.CPUCodeLibrary._optimize_final_module):
@@ -85,6 +87,20 @@ def _file_stamp(path):
 
 
 caching.CacheImpl.__init__ = _key_cache_to_callees
+
+
+class _CompileEvents(event.Listener):
+    """Forwards numba's compilations (not its disk-cache loads) to :mod:`fluidymation.engine.compiling`."""
+
+    def on_start(self, compilation):
+        compiling.notify(compilation.data["dispatcher"].py_func.__qualname__, True)
+
+    def on_end(self, compilation):
+        compiling.notify(compilation.data["dispatcher"].py_func.__qualname__, False)
+
+
+event.register("numba:compile", _CompileEvents())
+
 
 kernel = numba.njit(cache=True, fastmath=True, nogil=True)
 parallel_kernel = numba.njit(cache=True, fastmath=True, nogil=True, parallel=True)

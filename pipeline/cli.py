@@ -16,7 +16,7 @@ import traceback
 
 from fluidymation import __version__
 from fluidymation.errors import FluidymationError
-from fluidymation.pipeline.progress import use_json_lines
+from fluidymation.pipeline.progress import CompileNotice, use_json_lines
 
 #: The commands and their one-line help, in the order ``--help`` lists them. A command's module is
 #: imported only when that command runs, so ``--version``, ``--help`` and light commands start fast.
@@ -122,7 +122,11 @@ def main(argv: list[str] | None = None) -> int:
     try:
         args = build_parser(argv).parse_args(argv)
         use_json_lines(args.json)
-        return int(args.run(args) or 0)
+        notice = CompileNotice(quiet=args.quiet).listen()
+        try:
+            return int(args.run(args) or 0)
+        finally:
+            notice.close()
     except _UsageError as exc:
         print(exc, file=sys.stderr)
         return EXIT_USAGE

@@ -27,6 +27,7 @@ from fluidymation.pipeline import paths
 from fluidymation.pipeline.presets import resolve_params
 from fluidymation.pipeline.resolve import Plan, PlannedLayer
 from fluidymation.stages import exemplar_builtin, exemplar_store, exemplar_user, guides
+from fluidymation.stages.guide_params import for_exemplar
 from fluidymation.stages.files import read_image
 from fluidymation.stages.regions import read_regions
 
@@ -157,7 +158,7 @@ def _store_with_guides(entry: Path, record: str, rgb, masks, flow, guide_params:
     entry.parent.mkdir(parents=True, exist_ok=True)
     staging = tempfile.mkdtemp(prefix=f".{entry.name}.", dir=entry.parent)
     try:
-        guides.compute_guides(lambda j: masks[j], len(masks), params=guides.for_exemplar(guide_params), cache_dir=staging,
+        guides.compute_guides(lambda j: masks[j], len(masks), params=for_exemplar(guide_params), cache_dir=staging,
                               given_flow=None if flow is None else (lambda j: flow[j]))
         exemplar_store.store_colour(rgb, staging)
         if regions is not None:

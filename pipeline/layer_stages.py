@@ -65,9 +65,7 @@ def _mask_settings(work) -> MaskSettings:
 
 
 def _mask_inputs(work) -> dict:
-    document, renderer = work.plan.document, work.plan.renderer
-    return {"files": input_digest(work.plan), "reader": [document.reader, document.reader_version],
-            "choices": document.choices, "renderer": [renderer.name, renderer.version]}
+    return work.plan.drawing_record()
 
 
 def _run_masks(work, key: str) -> Done:
@@ -118,11 +116,6 @@ def layer_motion(out: Path, layer: PlannedLayer):
 def motion_reader(folder: Path):
     """``given_flow(j)`` reading the motion files :func:`write_layer_motion` wrote to ``folder``."""
     return lambda j: np.load(folder / f"{j:05d}.npy")
-
-
-def input_digest(plan: Plan) -> list[str]:
-    """Content hashes of the scene's vector input (every file of a numbered sequence)."""
-    return [file_digest(path) for path in plan.document.files]
 
 
 def rasterize_layer(plan: Plan, layer: PlannedLayer, frames: range, masks_dir: Path, *,

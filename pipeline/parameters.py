@@ -22,11 +22,11 @@ from fluidymation.pipeline.resolve import Plan, PlannedLayer
 from fluidymation.pipeline.schema import Checker
 from fluidymation.pipeline.stylizers import get_stylizer
 from fluidymation.pipeline.yaml_lines import KeyPath, LocatedYaml, load_yaml
-from fluidymation.stages import guides
+from fluidymation.stages.guide_params import Params as GuideParams
 from fluidymation.stages.stylizer import Stylizer
 
 #: Guides parameters a scene may set (``scale`` follows the output size).
-GUIDE_NAMES = tuple(field.name for field in dataclasses.fields(guides.Params) if field.name != "scale")
+GUIDE_NAMES = tuple(field.name for field in dataclasses.fields(GuideParams) if field.name != "scale")
 
 #: A value and where it was written: (document, key path), or None for values the program sets.
 Origin = tuple[LocatedYaml, KeyPath] | None
@@ -137,11 +137,11 @@ def _default_values(plan: Plan, stylizer: Stylizer) -> dict[str, tuple]:
     return values
 
 
-def layer_guide_params(plan: Plan, layer: PlannedLayer) -> guides.Params:
+def layer_guide_params(plan: Plan, layer: PlannedLayer) -> GuideParams:
     """Guides parameters of a layer: defaults < layer params of the same names; lengths scaled with the output size."""
     check_layer_params(plan, layer)
     values = _scene_values(plan, layer, GUIDE_NAMES) | {"scale": (plan.size[0] / plan.document.width, None)}
-    return build_params(guides.Params, values, fallback=_fallback(plan, layer))
+    return build_params(GuideParams, values, fallback=_fallback(plan, layer))
 
 
 def build_params(cls: type, values: dict[str, tuple], *, fallback: Origin):

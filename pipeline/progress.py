@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import json
 import sys
+import time
 
 
 _json_lines = False
@@ -71,3 +72,44 @@ def reporter(bar):
         bar.refresh()
 
     return report
+
+
+class CompileNotice:
+    """Says once, when numba starts compiling kernels (a first run, or after an upgrade), why the run is slow,
+    and counts the kernels on a progress line; later runs load them from numba's disk cache and hear nothing.
+
+    Listen with :meth:`listen` (it does not load numba) and :meth:`close` when the command ends.
+    """
+
+    def __init__(self, *, quiet: bool = False):
+        self.quiet, self.bar, self.compiled, self.started = quiet, None, 0, None
+
+    def listen(self) -> CompileNotice:
+        from fluidymation.engine import compiling
+
+        compiling.listeners.append(self.heard)
+        return self
+
+    def heard(self, kernel: str, started: bool) -> None:
+        if self.started is None:
+            self.started = time.monotonic()
+            if not self.quiet and not _json_lines:
+                print("compiling kernels (first run only: they are kept in numba's disk cache)", file=sys.stderr,
+                      flush=True)
+            self.bar = progress(None, "compiling kernels", quiet=self.quiet, unit="kernel").__enter__()
+        if not started:
+            self.compiled += 1
+            self.bar.update()
+
+    def close(self) -> None:
+        from fluidymation.engine import compiling
+
+        if self.heard in compiling.listeners:
+            compiling.listeners.remove(self.heard)
+        if self.bar is None:
+            return
+        self.bar.__exit__(None, None, None)
+        if not self.quiet and not _json_lines:
+            print(f"compiled {self.compiled} kernel{'' if self.compiled == 1 else 's'} in {time.monotonic() - self.started:.0f} s",
+                  file=sys.stderr)
+        self.bar = None

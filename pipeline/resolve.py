@@ -12,6 +12,7 @@ import re
 from dataclasses import dataclass, replace
 
 from fluidymation.errors import InputError, SceneError
+from fluidymation.pipeline.cache import file_digest
 from fluidymation.pipeline.scene import MAX_FRAMES, MAX_SIZE, LayerSpec, Scene
 from fluidymation.stages.vector import DEFAULT_FPS, Renderer, VectorDocument, open_document, renderer_for
 
@@ -55,6 +56,13 @@ class Plan:
     @property
     def frame_count(self) -> int:
         return self.end - self.start
+
+    def drawing_record(self) -> dict:
+        """What the layers' drawings depend on besides the layer, frame and size: the input's content (every
+        file of a numbered sequence), its reader, what was picked inside it, and the renderer (a stage key's part)."""
+        document, renderer = self.document, self.renderer
+        return {"files": [file_digest(path) for path in document.files], "reader": [document.reader, document.reader_version],
+                "choices": document.choices, "renderer": [renderer.name, renderer.version]}
 
     def layer(self, name: str) -> PlannedLayer:
         for layer in self.layers:

@@ -18,15 +18,18 @@ import json
 import logging
 from importlib import resources
 from pathlib import Path
-from typing import NamedTuple
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 
-from fluidymation.engine.nnf import NNF
-from fluidymation.stages import cartoon
-from fluidymation.stages.cartoon_clip import Clip, analyse_clip
+from fluidymation.stages import cartoon_params
 from fluidymation.stages.files import atomic_path
 from fluidymation.stages.stylizer import StylizeJob, Stylizer
+
+if TYPE_CHECKING:
+    from fluidymation.engine.nnf import NNF
+    from fluidymation.stages.cartoon import CartoonFrame
+    from fluidymation.stages.cartoon_clip import Clip
 
 log = logging.getLogger(__name__)
 
@@ -35,15 +38,17 @@ class CartoonStylizer(Stylizer):
     """The clip's drawn detail, moving with the clip's local motion, on the layer's shape and motion."""
 
     name = "cartoon"
-    version = cartoon.VERSION
-    Params = cartoon.Params
+    version = cartoon_params.VERSION
+    Params = cartoon_params.Params
     defaults = resources.files("fluidymation.configs").joinpath("cartoon.yaml")
     uses_guides = False
     default_colorize = "none"
     writes_nnf = True
     ablation = (("full", ()), ("no temporal", ("w_temporal",)), ("no position", ("w_position",)))
 
-    def stylize(self, job: StylizeJob, params: cartoon.Params):
+    def stylize(self, job: StylizeJob, params: cartoon_params.Params):
+        from fluidymation.stages import cartoon  # numerical code: imported when a layer is stylized, not when a scene is checked
+
         clip = layer_clip(job, params)
         synthesis = cartoon.CartoonSynthesis(clip, params)
         flow = job.motion() if job.frame_count > 1 else None
@@ -67,7 +72,10 @@ class CartoonStylizer(Stylizer):
         return {"frame": state.nnf.frame, "coords": state.nnf.coords, "rgba": state.rgba, "history": state.history}
 
     def resume_from(self, index: int, state: dict[str, np.ndarray]):
-        return cartoon.CartoonFrame(index, state["rgba"], NNF(state["frame"], state["coords"]), state["history"])
+        from fluidymation.engine.nnf import NNF  # numerical code: imported when a layer is stylized, not when a scene is checked
+        from fluidymation.stages.cartoon import CartoonFrame
+
+        return CartoonFrame(index, state["rgba"], NNF(state["frame"], state["coords"]), state["history"])
 
 
 class _Output(NamedTuple):
@@ -77,11 +85,13 @@ class _Output(NamedTuple):
     index: int
     rgba: np.ndarray
     nnf: NNF
-    state: cartoon.CartoonFrame
+    state: CartoonFrame
 
 
-def layer_clip(job: StylizeJob, params: cartoon.Params) -> Clip:
+def layer_clip(job: StylizeJob, params: cartoon_params.Params) -> Clip:
     """The layer's exemplar analysed as a clip, from the stage's work folder when an earlier run analysed it."""
+    from fluidymation.stages.cartoon_clip import Clip, analyse_clip  # numerical code: imported when a layer is stylized, not when a scene is checked
+
     source = job.source
     key = hashlib.sha256(json.dumps([str(source.cache.directory), repr(params.motion), params.seed]).encode())
     path = Path(job.work_dir or job.cache_dir) / f"clip-{key.hexdigest()[:16]}.npz"

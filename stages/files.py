@@ -14,7 +14,6 @@ import tempfile
 import warnings
 from pathlib import Path
 
-import imageio.v3 as iio
 import numpy as np
 
 from fluidymation.errors import InputError
@@ -82,6 +81,8 @@ def to_uint8(image: np.ndarray) -> np.ndarray:
 
 def write_png(path: str | os.PathLike, image: np.ndarray) -> None:
     """Write an (H, W), (H, W, 3) or (H, W, 4) image, float in [0, 1] or uint8, as PNG."""
+    import imageio.v3 as iio  # loaded on use: checking a scene reads and writes no images
+
     with atomic_path(path) as tmp:
         iio.imwrite(tmp, to_uint8(image), extension=".png")
 
@@ -101,6 +102,8 @@ def read_image(path: str | os.PathLike, *, channels: int | None = None) -> np.nd
     if not path.is_file():
         raise InputError(f"{path}: {'a folder, not an image file' if path.is_dir() else 'no such file'}")
     _check_declared_size(path)
+    import imageio.v3 as iio  # loaded on use, as in write_png
+
     try:
         data = iio.imread(path)
     except Exception as exc:

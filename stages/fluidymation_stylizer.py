@@ -1,6 +1,6 @@
 """The ``fluidymation`` stylizer: the paper's method (:mod:`fluidymation.stages.stylize`) as a plugin.
 
-Parameters are :class:`fluidymation.stages.stylize.Params`, their defaults
+Parameters are :class:`fluidymation.stages.stylize_params.Params`, their defaults
 ``configs/fluidymation.yaml``. The state kept per finished frame for resume is its NNF
 (source frame and coordinates per pixel), the motion not yet followed and its colour:
 exactly what :func:`~fluidymation.stages.stylize.stylize_sequence` needs to continue.
@@ -10,19 +10,23 @@ from __future__ import annotations
 
 from importlib import resources
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
-from fluidymation.engine.nnf import NNF
-from fluidymation.stages import stylize
+from fluidymation.stages import stylize_params
 from fluidymation.stages.stylizer import StylizeJob, Stylizer
+
+if TYPE_CHECKING:
+    from fluidymation.stages.stylize import StylizedFrame
 
 
 class FluidymationStylizer(Stylizer):
     """Moving-exemplar synthesis with the full Fluidymation energy (paper section 3, appendix B)."""
 
     name = "fluidymation"
-    version = stylize.VERSION
-    Params = stylize.Params
+    version = stylize_params.VERSION
+    Params = stylize_params.Params
     defaults = resources.files("fluidymation.configs").joinpath("fluidymation.yaml")
     writes_nnf = True
     ablation = (
@@ -36,17 +40,21 @@ class FluidymationStylizer(Stylizer):
         ("no dir+bound", ("w_dir", "w_bound")),
     )
 
-    def processing_order(self, frames: range, params: stylize.Params) -> list[int]:
+    def processing_order(self, frames: range, params: stylize_params.Params) -> list[int]:
         return sorted(frames, reverse=params.reverse)
 
-    def stylize(self, job: StylizeJob, params: stylize.Params):
+    def stylize(self, job: StylizeJob, params: stylize_params.Params):
+        from fluidymation.stages import stylize  # numerical code: imported when a layer is stylized, not when a scene is checked
+
         return stylize.stylize_sequence(job.masks, job.frame_count, job.source, params=params,
                                         guide_params=job.guide_params, cache_dir=job.cache_dir, frames=job.frames,
                                         resume=job.resume, given_flow=job.given_flow)
 
-    def frame_state(self, frame: stylize.StylizedFrame) -> dict[str, np.ndarray]:
+    def frame_state(self, frame: StylizedFrame) -> dict[str, np.ndarray]:
         return {"frame": frame.nnf.frame, "coords": frame.nnf.coords, "backlog": frame.backlog,
                 "rgb": frame.rgba[..., :3]}
 
     def resume_from(self, index: int, state: dict[str, np.ndarray]):
+        from fluidymation.engine.nnf import NNF  # numerical code: imported when a layer is stylized, not when a scene is checked
+
         return index, NNF(state["frame"], state["coords"]), state["backlog"], state["rgb"]

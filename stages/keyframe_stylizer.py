@@ -1,6 +1,6 @@
 """The ``keyframes`` stylizer: an artist's painted keyframes in-betweened along the layer's motion (seed 003).
 
-Parameters are :class:`fluidymation.stages.keyframe_morph.Params`, their defaults
+Parameters are :class:`fluidymation.stages.keyframe_params.Params`, their defaults
 ``configs/keyframes.yaml``; the method is :mod:`fluidymation.stages.keyframe_morph`
 (docs/keyframes.md). The motion is the layer's guides' flow (from the geometry with
 ``flow: vector``, else estimated from the masks). The morph's sweeps are checkpointed in
@@ -16,8 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-from fluidymation.stages import keyframe_morph
-from fluidymation.stages.keyframes import read_keyframe
+from fluidymation.stages import keyframe_params
 from fluidymation.stages.stylizer import Frame, StylizeJob, Stylizer
 
 log = logging.getLogger(__name__)
@@ -33,6 +32,8 @@ def painted_frame(rgba: np.ndarray, coverage: np.ndarray) -> np.ndarray:
 
 def read_keyframes(job: StylizeJob) -> dict[int, np.ndarray]:
     """The job's keyframes as premultiplied RGBA at the output size (errors name the file)."""
+    from fluidymation.stages.keyframes import read_keyframe  # numerical code: imported when a layer is stylized, not when a scene is checked
+
     return {frame: read_keyframe(path, frame, job.masks(frame)) for frame, path in sorted(job.keyframes.items())}
 
 
@@ -40,14 +41,16 @@ class KeyframeStylizer(Stylizer):
     """Painted keyframes in-betweened by the flow-guided regenerative morph (seed 003, sections 4–7)."""
 
     name = "keyframes"
-    version = keyframe_morph.VERSION
-    Params = keyframe_morph.Params
+    version = keyframe_params.VERSION
+    Params = keyframe_params.Params
     defaults = resources.files("fluidymation.configs").joinpath("keyframes.yaml")
     uses_keyframes = True
     default_colorize = "none"
     ablation = (("two-pass", ()), ("no neighbours", ("beta",)), ("no velocity modulation", ("gamma",)))
 
-    def stylize(self, job: StylizeJob, params: keyframe_morph.Params):
+    def stylize(self, job: StylizeJob, params: keyframe_params.Params):
+        from fluidymation.stages import keyframe_morph  # numerical code: imported when a layer is stylized, not when a scene is checked
+
         root = Path(job.work_dir or job.cache_dir) / "morph"
         keyframes = read_keyframes(job)
         keyframe_morph.prepare(root, job.masks, job.motion(), job.frame_count, keyframes)

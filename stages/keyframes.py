@@ -22,8 +22,8 @@ from scipy import ndimage
 
 from fluidymation.errors import InputError
 from fluidymation.stages.files import read_image
+from fluidymation.stages.keyframe_params import WEIGHTINGS
 
-WEIGHTINGS = ("blend", "radius", "smooth")
 #: The share of a keyframe's paint that may lie outside the layer's (slightly grown) mask.
 STRAY_LIMIT = 0.01
 #: How far (px) paint may reach past the mask's edge before it counts as stray.

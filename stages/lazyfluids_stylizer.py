@@ -16,20 +16,20 @@ from dataclasses import dataclass
 from importlib import resources
 
 from fluidymation.errors import ParameterError
-from fluidymation.stages import stylize
+from fluidymation.stages import stylize_params
 from fluidymation.stages.fluidymation_stylizer import FluidymationStylizer
 from fluidymation.stages.stylizer import StylizeJob
 
 
 @dataclass(frozen=True)
-class Params(stylize.Params):
-    """:class:`fluidymation.stages.stylize.Params` and ``exemplar_frame``: the exemplar frame that is the still."""
+class Params(stylize_params.Params):
+    """:class:`fluidymation.stages.stylize_params.Params` and ``exemplar_frame``: the exemplar frame that is the still."""
 
     exemplar_frame: int = 0
 
-    def synthesis(self) -> stylize.Params:
+    def synthesis(self) -> stylize_params.Params:
         """The parameters of the synthesis itself."""
-        return stylize.Params(**{field.name: getattr(self, field.name) for field in dataclasses.fields(stylize.Params)})
+        return stylize_params.Params(**{field.name: getattr(self, field.name) for field in dataclasses.fields(stylize_params.Params)})
 
 
 class OneFrame:

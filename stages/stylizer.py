@@ -28,11 +28,12 @@ from typing import TYPE_CHECKING, Any, Callable, ClassVar, Iterator, NamedTuple,
 
 import numpy as np
 
-from fluidymation.stages import guides
-from fluidymation.stages.exemplar_store import StoredSource
+from fluidymation.stages.guide_params import Params as GuideParams
 
 if TYPE_CHECKING:
     from importlib.resources.abc import Traversable
+
+    from fluidymation.stages.exemplar_store import StoredSource
 
 
 class StylizedFrame(Protocol):
@@ -77,7 +78,7 @@ class StylizeJob:
     frame_count: int
     frames: tuple[int, int]
     source: StoredSource
-    guide_params: guides.Params
+    guide_params: GuideParams
     cache_dir: str
     resume: Any = None
     given_flow: Callable[[int], np.ndarray] | None = None
@@ -92,6 +93,8 @@ class StylizeJob:
     def motion(self) -> Callable[[int], np.ndarray]:
         """``flow(j)``: the layer's motion into frame j as its guides see it (``given_flow`` where known, else the
         masks' estimate), the guides computed once into the scratch folder."""
+        from fluidymation.stages import guides  # numerical code: not imported for checking a scene
+
         cache = guides.compute_guides(self.masks, self.frame_count, params=self.guide_params,
                                       cache_dir=Path(self.cache_dir) / "guides", given_flow=self.given_flow)
         return lambda j: cache.read("flow", j)

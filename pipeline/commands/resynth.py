@@ -27,7 +27,7 @@ from fluidymation.errors import InputError
 from fluidymation.pipeline.panels import over_paper
 from fluidymation.pipeline.parameters import build_params, default_params
 from fluidymation.pipeline.progress import progress, reporter
-from fluidymation.stages import cartoon, encode, exemplar_user
+from fluidymation.stages import cartoon, cartoon_params, encode, exemplar_user
 from fluidymation.stages.cartoon_clip import Clip, analyse_clip
 from fluidymation.stages.files import atomic_path, read_image, write_png, write_text
 
@@ -116,7 +116,7 @@ def _run_key(args, params: cartoon.Params) -> str:
     """What decides the frames: the clip's and masks' files (names, sizes, times) and the parameters."""
     stamps = [(str(p), p.stat().st_size, p.stat().st_mtime_ns) for spec in (args.clip, args.mask)
               if spec != "auto" for p in _files(spec)]
-    text = json.dumps({"files": stamps, "mask": args.mask, "params": repr(params), "version": cartoon.VERSION})
+    text = json.dumps({"files": stamps, "mask": args.mask, "params": repr(params), "version": cartoon_params.VERSION})
     return hashlib.sha256(text.encode()).hexdigest()
 
 

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 from fluidymation.stages.vector.base import Renderer
-from fluidymation.stages.vector.raster import render_svg
 
 
 class CairoSvgRenderer(Renderer):
@@ -14,5 +13,7 @@ class CairoSvgRenderer(Renderer):
     kinds = ("svg", "svg-sequence")
 
     def render(self, document, layers, time_seconds, size):
+        from fluidymation.stages.vector.raster import render_svg  # cairo: loaded when something is drawn
+
         svg, source = document.isolate(layers, time_seconds)
         return render_svg(svg, size, source)

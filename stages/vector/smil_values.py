@@ -9,12 +9,11 @@ and plain strings, which only change discretely. Addition serves ``additive``,
 
 from __future__ import annotations
 
+import functools
 import math
 import re
 from abc import ABC, abstractmethod
 from typing import Any
-
-from cairosvg.colors import COLORS
 
 from fluidymation.stages.vector.smil_path import PathData
 
@@ -24,7 +23,6 @@ _LIST_SPLIT = re.compile(r"\s*,\s*|\s+")
 _PX_PER_UNIT = {"": 1.0, "px": 1.0, "pt": 96 / 72, "pc": 16.0, "mm": 96 / 25.4, "cm": 96 / 2.54, "in": 96.0}
 _HEX = re.compile(r"^#([0-9a-fA-F]{3}|[0-9a-fA-F]{6})$")
 _FUNCTIONAL = re.compile(r"^(rgba?)\(\s*([^)]*)\)$", re.IGNORECASE)
-_COLOUR_KEYWORDS = {name: value for name, value in COLORS.items() if name not in ("none", "transparent")}
 
 #: Attributes whose values are colours (when every value of an animation parses as one).
 COLOUR_ATTRIBUTES = {"fill", "stroke", "stop-color", "flood-color", "lighting-color", "color"}
@@ -32,6 +30,15 @@ COLOUR_ATTRIBUTES = {"fill", "stroke", "stop-color", "flood-color", "lighting-co
 TRANSFORM_PARAMETERS = {"translate": (2, (0.0, 0.0)), "scale": (2, (1.0, None)), "rotate": (3, (0.0, 0.0, 0.0)),
                         "skewX": (1, (0.0,)), "skewY": (1, (0.0,))}
 
+
+
+@functools.cache
+def _colour_keywords() -> dict[str, tuple]:
+    """The colour keywords as cairosvg draws them (its own table, so an animated keyword looks like a static one);
+    loaded on first use, as it loads cairo."""
+    from cairosvg.colors import COLORS
+
+    return {name: value for name, value in COLORS.items() if name not in ("none", "transparent")}
 
 class ValueType(ABC):
     """How one kind of attribute value is read, blended and written back."""
@@ -137,7 +144,7 @@ class ColourType(ValueType):
 
     def parse(self, text):
         text = text.strip()
-        keyword = _COLOUR_KEYWORDS.get(text.lower())
+        keyword = _colour_keywords().get(text.lower())
         if keyword is not None:
             return tuple(channel * 255 for channel in keyword[:3]) + (1.0,)
         match = _HEX.match(text)

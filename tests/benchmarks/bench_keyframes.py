@@ -85,14 +85,14 @@ def run(size: int, frames: int, key_every: int, jobs: int) -> dict:
 def schedules() -> None:
     """E of both schedules on tests/stages/test_keyframe_morph.py's scene (keys misregistered by 3 px, one pass)."""
     sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
-    from fluidymation.stages import keyframe_morph
+    from fluidymation.stages import keyframe_morph, keyframe_params
     from tests.stages import test_keyframe_morph as case
 
     keys = {0: case.painted(0), case.FRAMES - 1: case.painted(case.FRAMES - 1, shift=3)}
     print("sweeps  jacobi    sequential  difference")
     for sweeps in (2, 8, 16):
         energy = {}
-        for schedule in keyframe_morph.SCHEDULES:
+        for schedule in keyframe_params.SCHEDULES:
             with tempfile.TemporaryDirectory() as root:
                 _, contexts = case.morph(Path(root), keys, schedule=schedule, two_pass=False, sweeps=sweeps)
                 energy[schedule] = keyframe_morph.pass_energy(contexts[-1])

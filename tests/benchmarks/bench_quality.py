@@ -43,6 +43,7 @@ from fluidymation.pipeline.parameters import default_params
 from fluidymation.pipeline.presets import resolve_params
 from fluidymation.pipeline.stylizers import get_stylizer
 from fluidymation.stages import exemplar_builtin, exemplar_store, guides, stylize
+from fluidymation.stages.guide_params import for_exemplar
 
 ROOT = Path(__file__).resolve().parents[2]
 BASELINE = ROOT / "docs" / "quality" / "baseline.json"
@@ -203,7 +204,7 @@ def load_exemplar(medium: str, size: int, workdir: Path, guide_params: guides.Pa
     """The medium at ``size``² (from the user cache) with its guides, as the pipeline makes them."""
     params = resolve_params(medium, size=(size, size), frames=FRAMES)
     made = exemplar_builtin.make_builtin_exemplar(params, cache_dir=paths.exemplar_cache_dir())
-    cache = guides.compute_guides(lambda j: made.mask[j], FRAMES, params=guides.for_exemplar(guide_params),
+    cache = guides.compute_guides(lambda j: made.mask[j], FRAMES, params=for_exemplar(guide_params),
                                   cache_dir=workdir / f"{medium}-source", given_flow=lambda j: made.flow[j])
     return Exemplar(made.rgb, made.mask, exemplar_store.in_memory(made.rgb, cache),
                     exemplar_figures(made.rgb, made.mask, made.flow))

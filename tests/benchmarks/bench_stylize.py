@@ -14,6 +14,9 @@ Run: ``.venv/bin/python tests/benchmarks/bench_stylize.py [--cases speed memory 
   whole exemplar: the peak RSS follows the window, not the exemplar's length. The
   exemplar is stored (colour beside its guides, as the pipeline keeps it) before the
   runs, and each run reads it from disk (``StoredSource``).
+* 1080p: production size, a 1920×1080 target with a layer covering 30 % of the frame (an
+  ellipse drifting and turning) for 24 frames, the 400×222×20 exemplar of ``memory``.
+  Target: peak RSS ≤ 2 GiB, flat in the number of frames.
 
 Each case runs in its own process with ``NUMBA_NUM_THREADS`` threads. A tiny warm-up
 scene first loads (or compiles) numba's kernels; its time is shown as "warm-up". The
@@ -47,6 +50,7 @@ CASES = {
     "speed": ((500, 600), 6, (200, 200, 20), "ellipse"),
     "memory": ((1000, 800), 40, (400, 222, 20), "blob"),
     "window": ((400, 300), 30, (200, 200, 120), "small ellipse"),
+    "1080p": ((1920, 1080), 24, (400, 222, 20), "large ellipse"),
 }
 #: the source_window of each run of a case that compares windows (None: the whole exemplar)
 WINDOWS = {"window": (20, None)}
@@ -83,10 +87,11 @@ def exemplar_source(width, height, frames, guide_params, folder, *, stored=False
     from fluidymation.pipeline import paths
     from fluidymation.pipeline.presets import resolve_params
     from fluidymation.stages import exemplar_builtin, exemplar_store, guides
+    from fluidymation.stages.guide_params import for_exemplar
 
     params = resolve_params("watercolor-bloom", size=(width, height), frames=frames)
     exemplar = exemplar_builtin.make_builtin_exemplar(params, cache_dir=paths.exemplar_cache_dir())
-    cache = guides.compute_guides(lambda j: exemplar.mask[j], frames, params=guides.for_exemplar(guide_params), cache_dir=folder,
+    cache = guides.compute_guides(lambda j: exemplar.mask[j], frames, params=for_exemplar(guide_params), cache_dir=folder,
                                   given_flow=lambda j: exemplar.flow[j])
     if not stored:
         return exemplar_store.in_memory(exemplar.rgb, cache)
@@ -97,6 +102,9 @@ def exemplar_source(width, height, frames, guide_params, folder, *, stored=False
 def target_masks(shape, width, height):
     if shape == "small ellipse":
         return ellipse_masks(width, height, (100.0, 75.0))
+    if shape == "large ellipse":  # 30 % of the frame: π·a·b = 0.3·W·H with a : b = W : H
+        scale = np.sqrt(0.3 * 4.0 / np.pi) / 2.0
+        return ellipse_masks(width, height, (scale * width, scale * height))
     return (ellipse_masks if shape == "ellipse" else blob_masks)(width, height)
 
 

@@ -1,13 +1,14 @@
 """CLI conventions: global options before or after the command, one number for a square size, and a start-up
 that imports only what the command needs."""
 
+import os
 import subprocess
 import sys
 
 import imageio.v3 as iio
 import pytest
 
-from tests.scenes import blob_scene, write_scene
+from tests.scenes import ROOT, blob_scene, write_scene
 
 
 @pytest.mark.parametrize("words", [["-q", "check"], ["check", "-q"], ["check", "--json", "--strict"]])
@@ -46,3 +47,29 @@ def test_version_and_help_import_no_command_module_nor_numpy():
     out = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, check=True).stdout
     assert "LOADED []" in out
     assert "compare" in out and "render" in out  # --help still lists every command
+
+
+
+def _check(scene, cache) -> tuple[str, list[str]]:
+    """``check``'s output for ``scene`` and the heavy modules it loaded, in a fresh interpreter with the user cache
+    ``cache``."""
+    probe = ("import sys\nfrom fluidymation.pipeline.cli import main\n"
+             f"main(['check', {str(scene)!r}])\n"
+             "heavy = ('numba', 'scipy', 'cairocffi', 'imageio', 'fluidymation.engine')\n"
+             "print('LOADED', *sorted({h for h in heavy for m in sys.modules if m == h or m.startswith(h + '.')}))\n")
+    env = {**os.environ, "FLUIDYMATION_CACHE": str(cache)}
+    out = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, check=True, env=env).stdout
+    text, loaded = out.rsplit("LOADED", 1)
+    return text, loaded.split()
+
+
+def test_check_loads_no_numerical_code_and_draws_an_unchanged_input_once(tmp_path):
+    drawing = tmp_path / "blob.svg"
+    drawing.write_text((ROOT / "examples/blob/blob.svg").read_text())
+    scene = write_scene(tmp_path, blob_scene().replace(str(ROOT / "examples/blob/blob.svg"), str(drawing)))
+    text, loaded = _check(scene, tmp_path / "cache")
+    assert loaded == ["cairocffi"] and "file: #2a6fdb" in text  # the fill colours are drawn
+    assert _check(scene, tmp_path / "cache") == (text, [])  # and remembered
+    drawing.write_text(drawing.read_text().replace("#2a6fdb", "#123456"))
+    text, loaded = _check(scene, tmp_path / "cache")
+    assert loaded == ["cairocffi"] and "file: #123456" in text  # a changed input is drawn again

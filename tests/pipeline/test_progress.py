@@ -35,3 +35,26 @@ def test_debug_logs_say_what_each_stage_did(cli, tmp_path, monkeypatch, caplog):
     caplog.clear()
     assert cli("--debug", "-q", "render", _scene(tmp_path), "--until", "masks")[0] == 0
     assert "masks drop: cached (key" in caplog.text and "running" not in caplog.text
+
+
+def test_a_first_compilation_is_announced_once_and_counted(capsys):
+    import numba
+
+    from fluidymation.engine import _jit  # noqa: F401  (it forwards numba's compilations)
+    from fluidymation.pipeline.progress import CompileNotice
+
+    notice = CompileNotice().listen()
+    numba.njit(lambda x: x + 1)(1)  # not cached: numba compiles it here
+    numba.njit(lambda x: x * 2.0)(1.5)
+    notice.close()
+    numba.njit(lambda x: x - 1)(1)  # after close: not heard
+    err = capsys.readouterr().err
+    assert err.count("compiling kernels (first run only") == 1
+    assert "compiled 2 kernels in" in err
+
+
+def test_a_run_that_compiles_nothing_says_nothing(capsys):
+    from fluidymation.pipeline.progress import CompileNotice
+
+    CompileNotice().listen().close()
+    assert capsys.readouterr().err == ""

@@ -10,6 +10,7 @@ from scipy import ndimage
 from fluidymation.errors import InputError
 from fluidymation.pipeline.executors import run_jobs
 from fluidymation.stages import keyframe_morph as km
+from fluidymation.stages import keyframe_params
 from fluidymation.stages.keyframes import keyframe_weights, read_keyframe
 
 SIZE, FRAMES, RADIUS, STEP = 40, 7, 10.0, 2.0
@@ -71,7 +72,7 @@ def test_blend_without_neighbour_terms_reproduces_the_keyframes_exactly(tmp_path
 def test_parallel_sweeps_reach_the_sequential_energy(tmp_path):
     keys = {0: painted(0), FRAMES - 1: painted(FRAMES - 1, shift=3)}
     energies = {}
-    for schedule in km.SCHEDULES:
+    for schedule in keyframe_params.SCHEDULES:
         _, contexts = morph(tmp_path / schedule, keys, schedule=schedule, two_pass=False, sweeps=16)
         energies[schedule] = km.pass_energy(contexts[-1])
     assert energies["jacobi"] == pytest.approx(energies["sequential"], rel=1e-3)
