@@ -39,7 +39,8 @@ def _window_search(cost, source_segment, target_segment, centre, radius, nnf_fra
                 for x in range(max(cx - reach, 0), min(cx + reach + 1, source_width)):
                     if source_segment[0, y, x] < 0:
                         continue
-                    value = _patch_cost(cost, tx, ty, 0, np.float32(x), np.float32(y), np.float32(0.0), best)
+                    value = _patch_cost(cost, np.int64(tx), np.int64(ty), np.int64(0), np.float32(x), np.float32(y),
+                                        np.float32(0.0), best)
                     if value < best:
                         best = value
                         nnf_frame[ty, tx] = 0

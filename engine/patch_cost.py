@@ -69,8 +69,8 @@ def _plain_window_cost(cost, frame, sx, sy, tx, ty, bound):
     """The cost of the integer, unturned candidate ``(frame, sx, sy)`` at target ``(tx, ty)``
     where :func:`_is_plain_window` holds: the row-wise :func:`_window_ssd`."""
     return _window_ssd(
-        cost.source_rows, cost.target_rows, cost.run_weights, cost.source.shape[1], cost.radius, frame, sx, sy, tx, ty,
-        bound,
+        cost.source_rows, cost.target_rows, cost.run_weights, cost.source.shape[1], cost.radius, np.int64(frame),
+        np.int64(sx), np.int64(sy), np.int64(tx), np.int64(ty), np.float32(bound),
     )
 
 
@@ -96,7 +96,10 @@ def _is_plain_window(cost, tx, ty, x, y, theta):
 @kernel
 def _patch_cost(cost, tx, ty, frame, x, y, theta, bound):
     """The cost of source patch ``(frame, x, y, θ)`` at target pixel ``(tx, ty)``, any
-    candidate (stops once over ``bound``)."""
+    candidate (stops once over ``bound``).
+
+    Callers pass int64 ``tx``, ``ty`` and ``frame`` and float32 ``x``, ``y``, ``θ`` and ``bound``:
+    every other mix of types would be compiled again (seconds each, on a first run)."""
     source = cost.source
     target = cost.target
     feature_weights = cost.feature_weights
@@ -322,7 +325,8 @@ def _evaluate(cost, nnf_frame, nnf_coords, out):
                 out[ty, tx] = np.inf
                 continue
             out[ty, tx] = _patch_cost(
-                cost, tx, ty, frame, nnf_coords[ty, tx, 0], nnf_coords[ty, tx, 1], nnf_coords[ty, tx, 2], np.inf,
+                cost, np.int64(tx), np.int64(ty), np.int64(frame), nnf_coords[ty, tx, 0], nnf_coords[ty, tx, 1],
+                nnf_coords[ty, tx, 2], np.float32(np.inf),
             )
 
 
