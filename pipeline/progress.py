@@ -78,11 +78,14 @@ class CompileNotice:
     """Says once, when numba starts compiling kernels (a first run, or after an upgrade), why the run is slow,
     and counts the kernels on a progress line; later runs load them from numba's disk cache and hear nothing.
 
-    Listen with :meth:`listen` (it does not load numba) and :meth:`close` when the command ends.
+    Listen with :meth:`listen` (it does not load numba) and :meth:`close` when the command ends, which says
+    how many kernels were compiled and how long compiling took (numba compiles one kernel at a time, the
+    kernels it calls inside it).
     """
 
     def __init__(self, *, quiet: bool = False):
-        self.quiet, self.bar, self.compiled, self.started = quiet, None, 0, None
+        self.quiet, self.bar, self.compiled = quiet, None, 0
+        self.depth, self.since, self.seconds = 0, 0.0, 0.0
 
     def listen(self) -> CompileNotice:
         from fluidymation.engine import compiling
@@ -91,15 +94,21 @@ class CompileNotice:
         return self
 
     def heard(self, kernel: str, started: bool) -> None:
-        if self.started is None:
-            self.started = time.monotonic()
+        if self.bar is None:
             if not self.quiet and not _json_lines:
                 print("compiling kernels (first run only: they are kept in numba's disk cache)", file=sys.stderr,
                       flush=True)
             self.bar = progress(None, "compiling kernels", quiet=self.quiet, unit="kernel").__enter__()
-        if not started:
-            self.compiled += 1
-            self.bar.update()
+        if started:
+            if self.depth == 0:
+                self.since = time.monotonic()
+            self.depth += 1
+            return
+        self.depth -= 1
+        if self.depth == 0:
+            self.seconds += time.monotonic() - self.since
+        self.compiled += 1
+        self.bar.update()
 
     def close(self) -> None:
         from fluidymation.engine import compiling
@@ -110,6 +119,6 @@ class CompileNotice:
             return
         self.bar.__exit__(None, None, None)
         if not self.quiet and not _json_lines:
-            print(f"compiled {self.compiled} kernel{'' if self.compiled == 1 else 's'} in {time.monotonic() - self.started:.0f} s",
-                  file=sys.stderr)
+            kernels = f"{self.compiled} kernel{'' if self.compiled == 1 else 's'}"
+            print(f"compiled {kernels} in {self.seconds:.0f} s", file=sys.stderr)
         self.bar = None

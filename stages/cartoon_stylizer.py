@@ -47,7 +47,7 @@ class CartoonStylizer(Stylizer):
     ablation = (("full", ()), ("no temporal", ("w_temporal",)), ("no position", ("w_position",)))
 
     def stylize(self, job: StylizeJob, params: cartoon_params.Params):
-        from fluidymation.stages import cartoon  # numerical code: imported when a layer is stylized, not when a scene is checked
+        from fluidymation.stages import cartoon  # on use: check loads no numerical code
 
         clip = layer_clip(job, params)
         synthesis = cartoon.CartoonSynthesis(clip, params)
@@ -72,7 +72,7 @@ class CartoonStylizer(Stylizer):
         return {"frame": state.nnf.frame, "coords": state.nnf.coords, "rgba": state.rgba, "history": state.history}
 
     def resume_from(self, index: int, state: dict[str, np.ndarray]):
-        from fluidymation.engine.nnf import NNF  # numerical code: imported when a layer is stylized, not when a scene is checked
+        from fluidymation.engine.nnf import NNF  # on use: check loads no numerical code
         from fluidymation.stages.cartoon import CartoonFrame
 
         return CartoonFrame(index, state["rgba"], NNF(state["frame"], state["coords"]), state["history"])
@@ -90,7 +90,7 @@ class _Output(NamedTuple):
 
 def layer_clip(job: StylizeJob, params: cartoon_params.Params) -> Clip:
     """The layer's exemplar analysed as a clip, from the stage's work folder when an earlier run analysed it."""
-    from fluidymation.stages.cartoon_clip import Clip, analyse_clip  # numerical code: imported when a layer is stylized, not when a scene is checked
+    from fluidymation.stages.cartoon_clip import Clip, analyse_clip  # on use: check loads no numerical code
 
     source = job.source
     key = hashlib.sha256(json.dumps([str(source.cache.directory), repr(params.motion), params.seed]).encode())

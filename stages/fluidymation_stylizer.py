@@ -44,7 +44,7 @@ class FluidymationStylizer(Stylizer):
         return sorted(frames, reverse=params.reverse)
 
     def stylize(self, job: StylizeJob, params: stylize_params.Params):
-        from fluidymation.stages import stylize  # numerical code: imported when a layer is stylized, not when a scene is checked
+        from fluidymation.stages import stylize  # on use: check loads no numerical code
 
         return stylize.stylize_sequence(job.masks, job.frame_count, job.source, params=params,
                                         guide_params=job.guide_params, cache_dir=job.cache_dir, frames=job.frames,
@@ -55,6 +55,6 @@ class FluidymationStylizer(Stylizer):
                 "rgb": frame.rgba[..., :3]}
 
     def resume_from(self, index: int, state: dict[str, np.ndarray]):
-        from fluidymation.engine.nnf import NNF  # numerical code: imported when a layer is stylized, not when a scene is checked
+        from fluidymation.engine.nnf import NNF  # on use: check loads no numerical code
 
         return index, NNF(state["frame"], state["coords"]), state["backlog"], state["rgb"]

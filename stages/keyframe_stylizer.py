@@ -32,7 +32,7 @@ def painted_frame(rgba: np.ndarray, coverage: np.ndarray) -> np.ndarray:
 
 def read_keyframes(job: StylizeJob) -> dict[int, np.ndarray]:
     """The job's keyframes as premultiplied RGBA at the output size (errors name the file)."""
-    from fluidymation.stages.keyframes import read_keyframe  # numerical code: imported when a layer is stylized, not when a scene is checked
+    from fluidymation.stages.keyframes import read_keyframe  # on use: check loads no numerical code
 
     return {frame: read_keyframe(path, frame, job.masks(frame)) for frame, path in sorted(job.keyframes.items())}
 
@@ -49,7 +49,7 @@ class KeyframeStylizer(Stylizer):
     ablation = (("two-pass", ()), ("no neighbours", ("beta",)), ("no velocity modulation", ("gamma",)))
 
     def stylize(self, job: StylizeJob, params: keyframe_params.Params):
-        from fluidymation.stages import keyframe_morph  # numerical code: imported when a layer is stylized, not when a scene is checked
+        from fluidymation.stages import keyframe_morph  # on use: check loads no numerical code
 
         root = Path(job.work_dir or job.cache_dir) / "morph"
         keyframes = read_keyframes(job)

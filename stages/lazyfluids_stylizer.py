@@ -23,13 +23,15 @@ from fluidymation.stages.stylizer import StylizeJob
 
 @dataclass(frozen=True)
 class Params(stylize_params.Params):
-    """:class:`fluidymation.stages.stylize_params.Params` and ``exemplar_frame``: the exemplar frame that is the still."""
+    """:class:`fluidymation.stages.stylize_params.Params` and ``exemplar_frame``: the exemplar frame that is the
+    still."""
 
     exemplar_frame: int = 0
 
     def synthesis(self) -> stylize_params.Params:
         """The parameters of the synthesis itself."""
-        return stylize_params.Params(**{field.name: getattr(self, field.name) for field in dataclasses.fields(stylize_params.Params)})
+        synthesis = stylize_params.Params
+        return synthesis(**{field.name: getattr(self, field.name) for field in dataclasses.fields(synthesis)})
 
 
 class OneFrame:

@@ -37,7 +37,7 @@ class StillStylizer(Stylizer):
     ablation = (("full", ()), ("no uniformity", ("uniformity",)), ("no guide", ("w_guide",)))
 
     def stylize(self, job: StylizeJob, params: still_params.Params):
-        from fluidymation.stages import still  # numerical code: imported when a layer is stylized, not when a scene is checked
+        from fluidymation.stages import still  # on use: check loads no numerical code
 
         painting = still.painting_from(job.source, params.exemplar_frame)
         regions = still.layer_regions(((job.colours(j), job.masks(j)) for j in range(job.frame_count)),
@@ -61,6 +61,6 @@ class StillStylizer(Stylizer):
         return {"frame": frame.nnf.frame, "coords": frame.nnf.coords, "rgb": frame.rgba[..., :3]}
 
     def resume_from(self, index: int, state: dict[str, np.ndarray]):
-        from fluidymation.engine.nnf import NNF  # numerical code: imported when a layer is stylized, not when a scene is checked
+        from fluidymation.engine.nnf import NNF  # on use: check loads no numerical code
 
         return index, NNF(state["frame"], state["coords"]), state["rgb"]

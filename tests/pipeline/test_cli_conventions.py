@@ -55,7 +55,7 @@ def _check(scene, cache) -> tuple[str, list[str]]:
     ``cache``."""
     probe = ("import sys\nfrom fluidymation.pipeline.cli import main\n"
              f"main(['check', {str(scene)!r}])\n"
-             "heavy = ('numba', 'scipy', 'cairocffi', 'imageio', 'fluidymation.engine')\n"
+             "heavy = ('numba', 'scipy', 'cairocffi', 'imageio', 'fluidymation.engine._jit')\n"
              "print('LOADED', *sorted({h for h in heavy for m in sys.modules if m == h or m.startswith(h + '.')}))\n")
     env = {**os.environ, "FLUIDYMATION_CACHE": str(cache)}
     out = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, check=True, env=env).stdout

@@ -58,3 +58,16 @@ def test_a_run_that_compiles_nothing_says_nothing(capsys):
 
     CompileNotice().listen().close()
     assert capsys.readouterr().err == ""
+
+
+def test_compiling_time_counts_nested_compilations_once(capsys, monkeypatch):
+    from fluidymation.pipeline import progress
+
+    clock = iter([10.0, 13.0, 20.0, 21.0])
+    monkeypatch.setattr(progress.time, "monotonic", lambda: next(clock))
+    notice = progress.CompileNotice()
+    for kernel, started in (("outer", True), ("inner", True), ("inner", False), ("outer", False),
+                            ("other", True), ("other", False)):
+        notice.heard(kernel, started)
+    notice.close()
+    assert "compiled 3 kernels in 4 s" in capsys.readouterr().err  # (13 − 10) + (21 − 20): work between is not compiling
