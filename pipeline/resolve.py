@@ -61,8 +61,9 @@ class Plan:
         """What the layers' drawings depend on besides the layer, frame and size: the input's content (every
         file of a numbered sequence), its reader, what was picked inside it, and the renderer (a stage key's part)."""
         document, renderer = self.document, self.renderer
-        return {"files": [file_digest(path) for path in document.files], "reader": [document.reader, document.reader_version],
-                "choices": document.choices, "renderer": [renderer.name, renderer.version]}
+        return {"files": [file_digest(path) for path in document.files],
+                "reader": [document.reader, document.reader_version], "choices": document.choices,
+                "renderer": [renderer.name, renderer.version]}
 
     def layer(self, name: str) -> PlannedLayer:
         for layer in self.layers:
