@@ -125,6 +125,25 @@ def local_contrast(rgb: np.ndarray, region: np.ndarray, *, erosion: int = 3) -> 
     return float(spread[kept].mean())
 
 
+def frame_usage(match_frames: np.ndarray, region: np.ndarray, frame_count: int, *, erosion: int = 3) -> np.ndarray:
+    """Share of the matches inside ``region`` (eroded as in :func:`local_contrast`) that come from each
+    exemplar frame, (frame_count,); ``match_frames`` (H, W) holds each target pixel's exemplar frame
+    (−1: none). All zeros when no pixel of the eroded region has a match."""
+    kept = ndimage.binary_erosion(inside(region), iterations=erosion)
+    used = match_frames[kept & (match_frames >= 0)]
+    counts = np.bincount(used, minlength=frame_count)[:frame_count].astype(np.float64)
+    return counts / counts.sum() if counts.sum() > 0 else counts
+
+
+def used_contrast(usage: np.ndarray, exemplar_contrasts) -> float:
+    """The local contrast of the exemplar frames a target frame draws from, each weighted by its share of
+    the matches (:func:`frame_usage`): what an output that keeps the contrast of its sources shows.
+    nan when nothing is drawn."""
+    if usage.sum() == 0:
+        return float("nan")
+    return float(np.dot(usage, np.asarray(exemplar_contrasts, np.float64)))
+
+
 def change(before: np.ndarray, after: np.ndarray) -> np.ndarray:
     """Per-pixel frame-to-frame change: |after − before| averaged over R, G and B, (H, W)."""
     return np.abs(after[..., :3].astype(np.float64) - before[..., :3]).mean(axis=-1)

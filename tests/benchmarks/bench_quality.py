@@ -196,7 +196,7 @@ def exemplar_figures(rgb, mask, flow) -> dict:
     return {"profile": peak, "profile_band": band, "profile_curve": profile_curve(profile, counts),
             "blockiness": quality.blockiness(rgb, mask),
             "contrast_last_first": contrast[-1] / contrast[0], "contrast": float(np.mean(contrast)),
-            "still": still,
+            "contrasts": contrast, "still": still,
             "band_still": quality.ratio(quality.pooled_mean(changes, bands, min_pixels=MIN_REGION), still)}
 
 
@@ -210,27 +210,35 @@ def load_exemplar(medium: str, size: int, workdir: Path, guide_params: guides.Pa
                     exemplar_figures(made.rgb, made.mask, made.flow))
 
 
+def render_with_matches(scene: Scene, exemplar: Exemplar, params: stylize.Params, guide_params: guides.Params,
+                        cache_dir: Path, true_motion: bool = False) -> tuple[np.ndarray, np.ndarray]:
+    """The stylized layer, (T, H, W, 4), and each pixel's exemplar frame, (T, H, W) (−1: none); with
+    ``true_motion`` its guides take the scene's own motion (frame 0 that of frame 1)."""
+    given = (lambda j: scene.displacement(max(j, 1)).astype(np.float32)) if true_motion else None
+    frames = list(stylize.stylize_sequence(scene.coverage, FRAMES, exemplar.source, params=params,
+                                           guide_params=guide_params, cache_dir=cache_dir, given_flow=given))
+    return np.stack([frame.rgba for frame in frames]), np.stack([frame.nnf.frame for frame in frames])
+
+
 def render(scene: Scene, exemplar: Exemplar, params: stylize.Params, guide_params: guides.Params,
            cache_dir: Path, true_motion: bool = False) -> np.ndarray:
-    """The stylized layer, (T, H, W, 4); with ``true_motion`` its guides take the scene's own motion
-    (frame 0 that of frame 1)."""
-    given = (lambda j: scene.displacement(max(j, 1)).astype(np.float32)) if true_motion else None
-    frames = stylize.stylize_sequence(scene.coverage, FRAMES, exemplar.source, params=params,
-                                      guide_params=guide_params, cache_dir=cache_dir, given_flow=given)
-    return np.stack([frame.rgba for frame in frames])
+    """The stylized layer, (T, H, W, 4) (:func:`render_with_matches`)."""
+    return render_with_matches(scene, exemplar, params, guide_params, cache_dir, true_motion)[0]
 
 
 def measure(scene: Scene, exemplar: Exemplar, params: stylize.Params, guide_params: guides.Params,
             workdir: Path, true_motion: bool = False) -> tuple[dict, np.ndarray]:
     """Render the scene (and its ``w_temp: 0`` twin when it has a still region); return its figures and frames."""
     masks = [scene.coverage(t) for t in range(FRAMES)]
-    output = render(scene, exemplar, params, guide_params, workdir / "default", true_motion)
+    output, matched = render_with_matches(scene, exemplar, params, guide_params, workdir / "default", true_motion)
     still = [quality.still_region(masks[t - 1], masks[t], scene.displacement(t)) for t in range(1, FRAMES)]
     bands = [quality.moving_band(masks[t - 1], masks[t]) for t in range(1, FRAMES)]
     changes = [quality.change(a, b) for a, b in zip(output, output[1:])]
     profile, counts = quality.gradient_profile(output, masks)
     peak, band = quality.profile_peak_ratio(profile, counts)
     contrast = [quality.local_contrast(frame, mask) for frame, mask in zip(output, masks)]
+    used = [quality.used_contrast(quality.frame_usage(frames, mask, len(exemplar.rgb)), exemplar.figures["contrasts"])
+            for frames, mask in zip(matched, masks)]
     still_change = quality.pooled_mean(changes, still, min_pixels=MIN_REGION)
     independent = float("nan")
     if np.isfinite(still_change):
@@ -241,6 +249,7 @@ def measure(scene: Scene, exemplar: Exemplar, params: stylize.Params, guide_para
         "profile": peak, "profile_band": band, "profile_curve": profile_curve(profile, counts),
         "blockiness": quality.blockiness(output, masks),
         "contrast_last_first": contrast[-1] / contrast[0], "contrast": float(np.mean(contrast)),
+        "contrast_used": float(np.mean(used)), "used_last_first": used[-1] / used[0],
         "still": still_change, "still_w_temp0": independent,
         "band_still": quality.ratio(quality.pooled_mean(changes, bands, min_pixels=MIN_REGION), still_change),
         "iou": min(quality.iou(frame[..., 3], mask) for frame, mask in zip(output, masks)),
@@ -269,8 +278,8 @@ def verdicts(figures: dict, reference: dict, baseline: float | None) -> dict:
     }
 
 
-COLUMNS = ("scene", "profile", "blocks", "C last/1st", "C/ex", "still Δ", "still/wt0", "still/ex", "band/still",
-           "IoU", "fidelity")
+COLUMNS = ("scene", "profile", "blocks", "C last/1st", "C/ex", "used last/1st", "C/used", "still Δ", "still/wt0",
+           "still/ex", "band/still", "IoU", "fidelity")
 
 
 def _number(value, digits=2) -> str:
@@ -283,7 +292,7 @@ def _cell(text: str, verdict) -> str:
 
 def exemplar_row(medium: str, figures: dict) -> list[str]:
     return [f"{medium} (exemplar)", f"{_number(figures['profile'])}@{figures['profile_band']}",
-            f"{figures['blockiness'][0]:.3f}", _number(figures["contrast_last_first"]), "1",
+            f"{figures['blockiness'][0]:.3f}", _number(figures["contrast_last_first"]), "1", "", "",
             _number(1e3 * figures["still"]), "", "1", _number(figures["band_still"]), "", ""]
 
 
@@ -295,6 +304,7 @@ def scene_row(name: str, figures: dict, reference: dict, baseline: float | None)
             _cell(f"{figures['blockiness'][0]:.3f}", verdict["blocks"]),
             _cell(_number(figures["contrast_last_first"]), verdict["C last/1st"]),
             _cell(_number(quality.ratio(figures["contrast"], reference["contrast"])), verdict["C/ex"]),
+            _number(figures["used_last_first"]), _number(quality.ratio(figures["contrast"], figures["contrast_used"])),
             _number(1e3 * figures["still"]) + f" / {_number(1e3 * figures['still_w_temp0'])}",
             _cell(_number(quality.ratio(figures["still"], figures["still_w_temp0"])), verdict["still/wt0"]),
             _cell(_number(quality.ratio(figures["still"], reference["still"])), verdict["still/ex"]),
@@ -431,6 +441,13 @@ nearest outside pixel centre (1 next to the edge).
 - **C last/1st**, **C/ex**: local contrast is the mean 5×5 standard deviation of luminance
   inside the mask eroded by 3 px; the last frame's over the first's, and the mean over frames
   over the exemplar's mean over its frames (in its masks).
+- **used last/1st**, **C/used** (no threshold): the same contrast as the exemplar frames each output
+  frame draws from would give it: the exemplar's per-frame contrast weighted by the share of the
+  output's matches (in the same eroded mask) taken from that frame. `used last/1st` is how much the
+  medium itself changes between the frames the first and the last output frame draw from (the
+  paper moves a patch forward in exemplar time as the shape moves, so a moving shape ages with its
+  medium; `watercolor-bloom` loses contrast as it spreads); `C/used` is the output's mean contrast
+  over that of its sources: below 1 is wash-out by the synthesis itself, whatever frames it uses.
 - **still Δ** (×10⁻³): the mean over R, G, B of |frame t − frame t − 1|, pooled over the pixels
   of the still region of every pair: inside both masks ≥ 2 px from the edge in both, whose edge
   distance changes by < 0.1 px and whose known displacement (the scene's own motion) is

@@ -156,3 +156,20 @@ def test_compensated_residual_is_zero_for_texture_moved_with_the_shape():
     still = np.zeros((32, 40, 2))
     assert quality.compensated_residual(before, after, still, mask, mask_after) > 0.2  # |U − U'| averages 1/3
     assert np.isnan(quality.compensated_residual(before, after, moved, np.zeros_like(mask), mask_after))
+
+
+def test_frame_usage_counts_the_matches_inside_the_eroded_region():
+    mask = np.zeros((12, 12), bool)
+    mask[1:11, 1:11] = True  # eroded by 3 px: rows and columns 4..7, 16 pixels
+    frames = np.full((12, 12), 2, np.int32)
+    frames[4:6, 4:8] = 0  # 8 of the 16 from frame 0
+    frames[7, 4:8] = -1  # 4 unmatched
+    frames[0, :] = 1  # outside the mask: not counted
+    usage = quality.frame_usage(frames, mask, 3)
+    assert usage == pytest.approx([8 / 12, 0, 4 / 12])
+    assert not quality.frame_usage(np.full((12, 12), -1, np.int32), mask, 3).any()
+
+
+def test_used_contrast_weighs_each_exemplar_frame_by_its_share():
+    assert quality.used_contrast(np.array([0.25, 0.0, 0.75]), [0.04, 0.5, 0.02]) == pytest.approx(0.025)
+    assert np.isnan(quality.used_contrast(np.zeros(3), [0.04, 0.5, 0.02]))
