@@ -110,7 +110,7 @@ class Params:
     pyramid_levels: int | None = None
     reverse: bool = False
     carry: bool = False
-    settle_passes: int = 3
+    settle_passes: int = 2
     keep_margin: float = 0.2
     still_speed: float = 0.05
     source_window: int | None = None
