@@ -390,6 +390,10 @@ def _synthesize(sequence: _Sequence, k: int, frame: guides.FrameGuides, inside: 
                 initial, target_dist=border_clamped(frame.dist, target.border_width), source_dist=exemplar.dist,
                 previous_mask=previous.inside, lower=params.m_lower * sequence.d, upper=params.m_upper * sequence.d,
             )
+            # a settle pass's previous frame is itself; carried paint moved with the pixels, which this does not see
+            if settle_pass == 0 and k > 0 and params.recede_release > 0 and not params.carry:
+                modulation[0] *= receding_release(target.read("dist", k - 1), frame.dist, target.border_width,
+                                                  params.recede_release)
             if settle_pass == 0:  # a fresh start's settle passes converge freely
                 keep_margin = carried_margin(modulation[0], wanted, previous.inside, params)
     unit = sequence.unit
@@ -409,6 +413,13 @@ def _synthesize(sequence: _Sequence, k: int, frame: guides.FrameGuides, inside: 
                             seed=int(counter_hash(params.seed, k, settle_pass) % np.uint64(2**31))),
     )
     return dataclasses.replace(result, nnf=held.outside(result.nnf)), backlog
+
+
+def receding_release(before_dist: np.ndarray, dist: np.ndarray, border_width: float, release: float) -> np.ndarray:
+    """Factor (H, W) on m(q) where the edge moved inward: 1 − (fall of the border-clamped edge distance since the
+    previous frame) / ``release``, clipped to [0, 1] (``recede_release``; beyond the paper, docs/stylize.md)."""
+    fall = border_clamped(before_dist, border_width) - border_clamped(dist, border_width)
+    return np.clip(1.0 - fall / np.float32(release), 0.0, 1.0).astype(np.float32)
 
 
 def _unchanged_paint(nnf: NNF, previous: NNF, patch_size: int) -> np.ndarray:

@@ -78,6 +78,12 @@ class Params:
     still_speed : float
         Motion (px, since the previous frame and not yet followed) under which the target
         counts as still: there, carried-over matches are kept outright (0: never).
+    recede_release : float
+        Where the target's edge distance fell since the previous frame (the edge moving
+        inward past the pixel), m(q) is scaled down linearly, to 0 once it fell by this many
+        px: paint laid at the old edge cannot follow it inward (the paper's temporal coherence
+        is forward only, section 5), so it is painted afresh. Not with ``carry``. 0: the paper
+        (beyond the paper; docs/stylize.md).
     source_window : int or None
         Exemplar frames held and searched at a time (None: all). The window slides evenly
         from the exemplar's first frames at the first processing step to its last frames
@@ -113,6 +119,7 @@ class Params:
     settle_passes: int = 2
     keep_margin: float = 0.2
     still_speed: float = 0.05
+    recede_release: float = 2.0
     source_window: int | None = None
     seed: int = 0
 
@@ -140,6 +147,7 @@ class Params:
             ("finest_propagation", self.finest_propagation >= 0, "≥ 0"),
             ("keep_margin", 0 <= self.keep_margin <= 1, "between 0 and 1"),
             ("still_speed", self.still_speed >= 0, "≥ 0"),
+            ("recede_release", self.recede_release >= 0, "≥ 0"),
             ("source_window", self.source_window is None or (
                 isinstance(self.source_window, (int, np.integer)) and not isinstance(self.source_window, bool)
                 and self.source_window >= self.min_source_window),

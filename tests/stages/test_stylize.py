@@ -170,6 +170,14 @@ def test_carried_margin_keeps_still_paint_and_trusts_the_temporal_term_elsewhere
     np.testing.assert_array_equal(off, 0.0)
 
 
+def test_receding_release_lets_go_where_the_edge_moved_inward():
+    before = np.array([5.0, 5.0, 5.0, 5.0, 14.0, 3.0], np.float32)
+    after = np.array([5.0, 6.0, 4.0, 2.0, 11.0, -1.0], np.float32)  # still, outward, 1 px in, 3 px in, interior, left
+    factor = stylize.receding_release(before, after, border_width=10.0, release=2.0)
+    # inward by 1 px: half; by ≥ 2 px: none; beyond the border clamp (14 → 11 reads 10 → 10): unchanged
+    np.testing.assert_allclose(factor, [1.0, 1.0, 0.5, 0.0, 1.0, 0.0])
+
+
 def test_deterministic_whatever_the_thread_count(source, tmp_path):
     threads = numba.get_num_threads()
     try:
