@@ -25,6 +25,12 @@ def inside(mask: np.ndarray) -> np.ndarray:
     return np.asarray(mask) >= 0.5
 
 
+def inside_eroded(mask: np.ndarray, margin: int) -> np.ndarray:
+    """:func:`inside`, eroded by ``margin`` px (0: as it is; scipy would erode a 0-iteration call to nothing)."""
+    kept = inside(mask)
+    return ndimage.binary_erosion(kept, iterations=margin) if margin else kept
+
+
 def edge_distance(mask: np.ndarray) -> np.ndarray:
     """Euclidean distance (px) of each inside pixel to the nearest outside pixel centre; 0 outside.
 
@@ -91,7 +97,7 @@ def blockiness(frames, masks, *, periods=(2,), margin: int = 2) -> tuple[float, 
     counts = {(axis, p): np.zeros(p) for axis in (0, 1) for p in periods}
     for rgb, mask in zip(frames, masks):
         lum = luminance(rgb)
-        region = ndimage.binary_erosion(inside(mask), iterations=margin) if margin else inside(mask)
+        region = inside_eroded(mask, margin)
         for axis in (0, 1):
             step = np.abs(np.diff(lum, axis=axis))
             both = region[1:] & region[:-1] if axis == 0 else region[:, 1:] & region[:, :-1]
@@ -116,7 +122,7 @@ def blockiness(frames, masks, *, periods=(2,), margin: int = 2) -> tuple[float, 
 def local_contrast(rgb: np.ndarray, region: np.ndarray, *, erosion: int = 3) -> float:
     """Mean 5×5 standard deviation of the luminance inside ``region`` eroded by ``erosion`` px (wash-out);
     nan when nothing of the region is left."""
-    kept = ndimage.binary_erosion(inside(region), iterations=erosion)
+    kept = inside_eroded(region, erosion)
     if not kept.any():
         return float("nan")
     lum = luminance(rgb)
@@ -129,7 +135,7 @@ def frame_usage(match_frames: np.ndarray, region: np.ndarray, frame_count: int, 
     """Share of the matches inside ``region`` (eroded as in :func:`local_contrast`) that come from each
     exemplar frame, (frame_count,); ``match_frames`` (H, W) holds each target pixel's exemplar frame
     (−1: none). All zeros when no pixel of the eroded region has a match."""
-    kept = ndimage.binary_erosion(inside(region), iterations=erosion)
+    kept = inside_eroded(region, erosion)
     used = match_frames[kept & (match_frames >= 0)]
     counts = np.bincount(used, minlength=frame_count)[:frame_count].astype(np.float64)
     return counts / counts.sum() if counts.sum() > 0 else counts
@@ -181,9 +187,9 @@ def compensated_residual(before, after, displacement, mask_before, mask_after, *
     averaged; ``before`` sampled bilinearly) over the pixels ``margin`` px inside ``mask_after`` whose origin
     q − d(q) lies ``margin`` px inside ``mask_before``; ``displacement`` (H, W, 2) is the shape's motion d into
     the later frame. Near 0 when the paint travels with the shape (``carry``)."""
-    kept_before = ndimage.binary_erosion(inside(mask_before), iterations=margin)
+    kept_before = inside_eroded(mask_before, margin)
     came_from = sample_back(kept_before, displacement, order=0) > 0
-    region = ndimage.binary_erosion(inside(mask_after), iterations=margin) & came_from
+    region = inside_eroded(mask_after, margin) & came_from
     moved = sample_back(np.asarray(before)[..., :3], displacement)
     return float(change(moved, after)[region].mean()) if region.any() else float("nan")
 

@@ -36,7 +36,9 @@ import sys
 import tempfile
 import time
 from pathlib import Path
+from types import SimpleNamespace
 
+import numba
 import numpy as np
 from numba import prange
 
@@ -45,6 +47,8 @@ from fluidymation.engine.nnf import NNF, fill_random, merge_nnf, upscale_nnf
 from fluidymation.engine.patch_cost import _patch_cost, patch_errors, quantize_source, target_patch_cost
 from fluidymation.engine.patchmatch import patchmatch_pass
 from fluidymation.engine.pyramid import gaussian_pyramid, levels_that_fit
+from fluidymation.pipeline.commands.synth import load_job
+from fluidymation.stages.files import read_image
 
 DATA = Path(os.environ.get("EBSYNTH_EXAMPLES", "/work/shared/data/ebsynth-examples"))
 EBSYNTH_SECONDS = {"stylit": 62.4, "facestyle": 75.1}
@@ -106,10 +110,6 @@ def ebsynth_arguments(binary, folder, style, guides, output):
 
 def _job_inputs(folder, style, guides):
     """The job's :class:`SynthesisInputs` exactly as ``fluidymation synth`` reads them (its weighting)."""
-    from types import SimpleNamespace
-
-    from fluidymation.pipeline.commands.synth import load_job
-
     return load_job(SimpleNamespace(style=str(folder / style), style_weight=None,
                                     guides=[[str(folder / source), str(folder / target), weight]
                                             for source, target, weight in guides]))
@@ -117,8 +117,6 @@ def _job_inputs(folder, style, guides):
 
 def _read_output(path, channels):
     """An output PNG as float32 (H, W, channels) in [0, 1], EbSynth's and ours alike."""
-    from fluidymation.stages.files import read_image
-
     image = read_image(path)
     if image.shape[2] != channels:
         image = read_image(path, channels=channels if channels in (1, 3, 4) else None)
@@ -292,8 +290,6 @@ def main():
 
 def print_energies(args, out):
     """Score each job's two outputs (written above) under :func:`guided_energy` and print them."""
-    import numba
-
     numba.set_num_threads(min(args.threads, numba.config.NUMBA_NUM_THREADS))  # the same results on any count
     print(f"\nguided energy (0..255 units, lower is better; search: {args.energy_restarts} restarts, "
           f"{args.energy_passes} passes per level and restart, {2 * args.energy_passes} final; "
