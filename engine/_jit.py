@@ -138,10 +138,12 @@ def prefetch(typingctx, array, index):
     return types.void(array, index), codegen
 
 
-#: Jobs over fewer pixels run their parallel kernels on one thread: on the shared 2-core
-#: machine a parallel region waits for its slowest thread, which then often waits for a
-#: busy core (measured: a 38×32 PatchMatch pass 8.8 ms on two threads, 1.7 ms on one).
-SERIAL_BELOW_PIXELS = 1 << 15
+#: Jobs over fewer pixels (64×64) run their parallel kernels on one thread: on the shared
+#: 2-core machine a parallel region waits for its slowest thread, which then often waits for
+#: a busy core (measured: a 38×32 PatchMatch pass 8.8 ms on two threads, 1.7 ms on one).
+#: Above 64×64 two threads pay: bench_synth's small job 2.25 s with this bound against 2.65 s
+#: with 1 << 15 (two runs each, load 0.2–0.4); bench_stylize speed unchanged within noise.
+SERIAL_BELOW_PIXELS = 1 << 12
 
 
 @contextlib.contextmanager

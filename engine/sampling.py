@@ -11,7 +11,6 @@ outside the image are clamped to the nearest edge pixel.
 import math
 
 import numpy as np
-from scipy import ndimage
 
 from fluidymation.engine._jit import kernel
 
@@ -87,6 +86,8 @@ def sample_patch(source, frame, x, y, theta, *, patch_size=5):
 def sample_back(values: np.ndarray, flow: np.ndarray, *, order: int = 1) -> np.ndarray:
     """``values`` (H, W) or (H, W, C) sampled where each pixel's material came from, q − ``flow``(q) (the motion
     that brought it there), bilinearly (``order`` 1) or at the nearest pixel (0), edges repeated; float64."""
+    from scipy import ndimage  # here, not at the top: the synthesis path imports this module and not scipy (0.3 s)
+
     height, width = flow.shape[:2]
     ys, xs = np.mgrid[:height, :width].astype(np.float64)
     came_from = [ys - flow[..., 1], xs - flow[..., 0]]
