@@ -74,4 +74,9 @@ def test_editing_a_called_kernel_recompiles_its_callers(tmp_path):
     cache = tmp_path / "numba-cache"
     assert _run(cache, script, tmp_path) == "3.0"
     callee.write_text(callee.read_text().replace("2.0", "3.0"))
+    # an edit made seconds later, as a person makes it: Python's bytecode cache compares
+    # whole seconds of the source's mtime, so a same-size edit within the second that
+    # wrote the .pyc would import the old scale whatever numba does
+    edited = callee.stat().st_mtime_ns + 2_000_000_000
+    os.utime(callee, ns=(edited, edited))
     assert _run(cache, script, tmp_path) == "4.0"  # not the cached caller's copy of the old scale
