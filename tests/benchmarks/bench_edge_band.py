@@ -8,8 +8,9 @@ default size) through the CLI into a temporary folder and prints, over those fra
 with the layer's alpha as the mask (:mod:`fluidymation.quality`): the edge-gradient
 profile's peak/median over bands 5–40 px and the profile of bands 1–20 over that median,
 then the local contrast over the exemplar's. ``--crop`` writes frame 24 of the layer over
-paper, 3× enlarged around the blob (the README's before/after of the edge band). Run it
-from a checkout of an older commit to measure the stylizer before a change.
+paper, 3× enlarged around the blob; with ``--before BEFORE.png`` (a crop written the same
+way by an older commit) it writes the two side by side, the README's before/after of the
+edge band. Run it from a checkout of an older commit to measure the stylizer before a change.
 """
 
 from __future__ import annotations
@@ -38,6 +39,8 @@ CROP_FRAME = 24
 #: rows and columns of the crop, around the blob at frame 24
 CROP = (slice(70, 200), slice(50, 200))
 ZOOM = 3
+#: white columns between the before and after crops
+GAP = 8
 
 
 def render(workdir: Path, params: dict) -> list[np.ndarray]:
@@ -67,12 +70,23 @@ def crop(frame: np.ndarray) -> Image.Image:
     return Image.fromarray(part).resize((part.shape[1] * ZOOM, part.shape[0] * ZOOM), Image.LANCZOS)
 
 
+def side_by_side(before: Image.Image, after: Image.Image) -> Image.Image:
+    """``before`` and ``after`` in one image, a white gap between them."""
+    pair = Image.new("RGB", (before.width + GAP + after.width, max(before.height, after.height)), "white")
+    pair.paste(before.convert("RGB"), (0, 0))
+    pair.paste(after, (before.width + GAP, 0))
+    return pair
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--param", action="append", default=[], metavar="NAME=VALUE",
                         help="a stylizer parameter instead of its default (YAML value; repeatable)")
     parser.add_argument("--crop", type=Path, help="write frame 24's crop here")
+    parser.add_argument("--before", type=Path, help="with --crop: an older crop to put on the left")
     args = parser.parse_args()
+    if args.before and not args.crop:
+        parser.error("--before needs --crop")
     params = overrides(args.param)
     with tempfile.TemporaryDirectory() as workdir:
         frames = render(Path(workdir), params)
@@ -85,7 +99,8 @@ def main():
     print("bands 1-20 / median:", " ".join(f"{value:.2f}" for value in profile_curve(profile, counts)))
     print(f"local contrast / exemplar's {contrast / exemplar_contrast():.2f}")
     if args.crop:
-        crop(frames[CROP_FRAME]).save(args.crop)
+        after = crop(frames[CROP_FRAME])
+        (side_by_side(Image.open(args.before), after) if args.before else after).save(args.crop)
         print(f"wrote {args.crop}")
 
 

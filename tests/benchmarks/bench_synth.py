@@ -9,7 +9,7 @@ job drawn here (a two-region style and label maps). With ``--ebsynth BIN`` (EbSy
 public CPU build, ``build-linux-cpu_only.sh`` of jamriska/ebsynth, built for measuring
 only) each job also runs through EbSynth in the same run, right after ours, with as many
 OpenMP threads, and the ratio is printed; without it EbSynth's column is the figure once
-measured on this kind of machine (``EBSYNTH_SECONDS``; none for ``small``).
+measured on this kind of machine (``EBSYNTH_SECONDS``).
 
 With ``--energy`` (needs ``--ebsynth``) both outputs of each job are then scored under one
 guided patch energy, by :func:`guided_energy`: the mean over target pixels of the patch
@@ -51,7 +51,8 @@ from fluidymation.pipeline.commands.synth import load_job
 from fluidymation.stages.files import read_image
 
 DATA = Path(os.environ.get("EBSYNTH_EXAMPLES", "/work/shared/data/ebsynth-examples"))
-EBSYNTH_SECONDS = {"stylit": 62.4, "facestyle": 75.1}
+#: EbSynth's wall times on 2026-12-06, 2 threads, load 1.2–1.9 (machines differ by up to 3×)
+EBSYNTH_SECONDS = {"stylit": 41.1, "facestyle": 20.6, "small": 1.0}
 _EBSYNTH_SCALE = 255.0 ** 2  # energies: values in 0..1 compared, reported in EbSynth's 0..255 units
 JOBS = {
     "stylit": ("source_style.png", [(f"source_{g}.png", f"target_{g}.png", 0.5) for g in ("fullgi", "dirdif", "indirb", "dirspc")]),
