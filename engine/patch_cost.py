@@ -21,8 +21,8 @@ search knows only the patch-SSD object it is given: it takes the cost as one num
 here, which take it first: :func:`_patch_cost` for any candidate; for unrotated integer
 candidates of a plain cost, checked with :func:`_is_plain_window`, the row-wise SSD
 :func:`_plain_window_cost`; for turned ones (flow-aligned synthesis) :func:`_rotated_cost`,
-a float32 cost whose feature loop vectorizes, told by :func:`_centre_turn` when to swap
-the features; :func:`_prefetch_window` starts loading a candidate's data.
+a float32 cost whose feature loop vectorizes; a random candidate's two flow-aligned angles share their samples in
+:func:`_flow_pair_cost`; :func:`_prefetch_window` starts loading a candidate's data.
 """
 
 from __future__ import annotations
@@ -288,13 +288,104 @@ def _rotated_cost(cost, tx, ty, frame, x, y, theta, cos_t, sin_t, opposite, boun
 
 
 @inline_kernel
-def _centre_turn(cost, frame, sx, sy, theta, tx, ty):
-    """``cos(S_dir − θ − T_dir)`` between the integer source centre ``(frame, sx, sy)`` and
-    target pixel ``(tx, ty)``, or 1 when the cost swaps no features: where it is negative
-    :func:`_rotated_cost` is to compare the swapped features (``opposite``)."""
-    if not cost.use_opposite:
-        return 1.0
-    return math.cos(cost.source_angle[frame, sy, sx] - theta - cost.target_angle[ty, tx])
+def _flow_pair_cost(cost, tx, ty, frame, x, y, theta, cos_t, sin_t, bound):
+    """The costs of a candidate at both flow-aligned angles: θ (``cos_t``, ``sin_t`` given) with
+    the features as they are, and θ + π with the swapped features, as two :func:`_rotated_cost`
+    calls would give them (up to the order of summation).
+
+    θ lays the source flow at the centre onto the target's, so the flows there agree at θ and
+    are opposite at θ + π. Turned by π the patch samples the source at the offsets of θ
+    mirrored through the centre: each bilinear sample serves both angles, θ's target pixel
+    ``q + d`` and θ + π's ``q − d``. Stops once both partial sums exceed ``bound``."""
+    source_rows = cost.source_rows
+    target_rows = cost.target_rows
+    target_weight_rows = cost.target_weight_rows
+    swapped_rows = cost.swapped_rows
+    swapped_weight_rows = cost.swapped_weight_rows
+    source_angle = cost.source_angle
+    target_angle = cost.target_angle
+    orientation_weight = cost.orientation_weight
+    orientation_clamp = cost.orientation_clamp
+    feature_start = cost.feature_start
+    radius = cost.radius
+    source_height = cost.source.shape[1]
+    source_width = cost.source.shape[2]
+    features = source_rows.shape[1] // source_width
+    height = target_rows.shape[0]
+    width = target_rows.shape[1] // features
+    length = features - feature_start
+    per_pixel = target_weight_rows.shape[0] * target_weight_rows.shape[1] > features
+    high_x = np.float32(source_width - 1)
+    high_y = np.float32(source_height - 1)
+    one = np.float32(1.0)
+    flipped = theta + np.float32(math.pi)
+    frame_row = frame * source_height
+    first = np.float32(0.0)
+    second = np.float32(0.0)
+    for dy in range(-radius, radius + 1):
+        for dx in range(-radius, radius + 1):
+            qx = tx + dx
+            qy = ty + dy
+            mx = tx - dx
+            my = ty - dy
+            use_first = first <= bound and 0 <= qx < width and 0 <= qy < height
+            use_second = second <= bound and 0 <= mx < width and 0 <= my < height
+            if not (use_first or use_second):
+                continue
+            sample_x = min(max(x + cos_t * np.float32(dx) - sin_t * np.float32(dy), np.float32(0.0)), high_x)
+            sample_y = min(max(y + sin_t * np.float32(dx) + cos_t * np.float32(dy), np.float32(0.0)), high_y)
+            x0 = int(sample_x)
+            y0 = int(sample_y)
+            fx = sample_x - np.float32(x0)
+            fy = sample_y - np.float32(y0)
+            w00 = (one - fx) * (one - fy)
+            w10 = fx * (one - fy)
+            w01 = (one - fx) * fy
+            w11 = fx * fy
+            row0 = frame_row + y0
+            row1 = frame_row + min(y0 + 1, source_height - 1)
+            column0 = x0 * features + feature_start
+            column1 = min(x0 + 1, source_width - 1) * features + feature_start
+            s00 = source_rows[row0, column0:column0 + length]
+            s10 = source_rows[row0, column1:column1 + length]
+            s01 = source_rows[row1, column0:column0 + length]
+            s11 = source_rows[row1, column1:column1 + length]
+            first_column = qx * features + feature_start
+            second_column = mx * features + feature_start
+            t = target_rows[qy if use_first else my, first_column if use_first else second_column:][:length]
+            u = swapped_rows[my if use_second else qy, second_column if use_second else first_column:][:length]
+            if per_pixel:
+                w = target_weight_rows[qy if use_first else my, first_column if use_first else second_column:][:length]
+                v = swapped_weight_rows[my if use_second else qy, second_column if use_second else first_column:][:length]
+            else:
+                w = target_weight_rows[0, feature_start:features]
+                v = swapped_weight_rows[0, feature_start:features]
+            part_first = np.float32(0.0)
+            part_second = np.float32(0.0)
+            for k in range(length):
+                value = (
+                    w00 * np.float32(s00[k]) + w10 * np.float32(s10[k])
+                    + w01 * np.float32(s01[k]) + w11 * np.float32(s11[k])
+                )
+                d = value - np.float32(t[k])
+                part_first += w[k] * d * d
+                e = value - np.float32(u[k])
+                part_second += v[k] * e * e
+            if orientation_weight > 0.0:
+                nearest_x = int(sample_x + np.float32(0.5))
+                nearest_y = int(sample_y + np.float32(0.5))
+                along = source_angle[frame, nearest_y, nearest_x]
+                if use_first:
+                    part_first += orientation_weight * min(abs(math.tan(along - theta - target_angle[qy, qx])),
+                                                           orientation_clamp)
+                if use_second:
+                    part_second += orientation_weight * min(abs(math.tan(along - flipped - target_angle[my, mx])),
+                                                            orientation_clamp)
+            if use_first:
+                first += part_first
+            if use_second:
+                second += part_second
+    return first, second
 
 
 @inline_kernel

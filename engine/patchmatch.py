@@ -11,13 +11,15 @@ source (:mod:`fluidymation.engine.uniformity`), times an optional per-target-pix
 factor; a candidate replaces the match when its total is lower, by an optional
 per-pixel relative margin. A target pixel only matches source patches whose centre has
 the same segment label; pixels labelled -1 are not synthesized. With ``ROTATION_FLOW``
-each random candidate is tried at both flow-aligned angles.
+each random candidate is tried at both flow-aligned angles, θ and θ + π, whose patches share
+their bilinear samples (mirrored through the centre), so one pass over them costs both.
 
 Speed: the random search is bound by cache misses on its far candidates, so each
 pixel draws all its candidates first (boxes around the match after propagation, as
 EbSynth does) and prefetches their data ``PREFETCH_AHEAD`` candidates before comparing
 them; unrotated integer candidates of a plain cost go straight to the cost's row-wise
-SSD, turned ones (flow-aligned synthesis) to its float32 rotated cost.
+SSD, turned ones (flow-aligned synthesis) to its float32 rotated cost, the pair of
+flow-aligned angles to its shared-sample pair cost.
 
 Parallelism: the target is cut into fixed bands of rows (tiles), processed in parallel.
 Inside a tile, propagation reads the live field; across a tile border it reads the
@@ -35,7 +37,7 @@ from numba import prange
 from fluidymation.engine._jit import inline_kernel, kernel, parallel_kernel, prefetch
 from fluidymation.engine.nnf import ROTATION_FLOW, _flow_rotation
 from fluidymation.engine.patch_cost import (
-    _centre_turn, _is_plain_window, _patch_cost, _plain_window_cost, _prefetch_window, _rotated_cost,
+    _flow_pair_cost, _is_plain_window, _patch_cost, _plain_window_cost, _prefetch_window,
 )
 from fluidymation.engine.random import _key4, _random_below
 
@@ -207,28 +209,23 @@ def _search_tile(
                 if cand_penalty >= accept_below:
                     continue
                 if rotation_mode == ROTATION_FLOW:
-                    # both flow-aligned angles, θ and θ + π: one sine and cosine, and (cos of the
-                    # turn between the flows being ±1) the second one swaps the features when the first does not
+                    # both flow-aligned angles, θ and θ + π, in one pass over shared samples
                     theta = np.float32(
                         _flow_rotation(target_angle, source_angle, cand_frame, cx, cy, tx, ty, False)
                     )
-                    cos_t = np.float32(math.cos(theta))
-                    sin_t = np.float32(math.sin(theta))
-                    turn = _centre_turn(cost, cand_frame, cx_int, cy_int, theta, tx, ty)
+                    first_error, second_error = _flow_pair_cost(
+                        cost, tx, ty, cand_frame, cx, cy, theta, np.float32(math.cos(theta)),
+                        np.float32(math.sin(theta)), accept_below - cand_penalty,
+                    )
                     for flip in range(2):
-                        bound = accept_below - cand_penalty
-                        cand_theta = theta if flip == 0 else np.float32(
-                            _flow_rotation(target_angle, source_angle, cand_frame, cx, cy, tx, ty, True)
-                        )
-                        cand_error = _rotated_cost(
-                            cost, tx, ty, cand_frame, cx, cy, cand_theta, cos_t if flip == 0 else -cos_t,
-                            sin_t if flip == 0 else -sin_t, turn < 0.0 if flip == 0 else turn > 0.0, bound,
-                        )
+                        cand_error = first_error if flip == 0 else second_error
                         if cand_error + cand_penalty < accept_below:
                             best_frame = cand_frame
                             best_x = cx
                             best_y = cy
-                            best_theta = cand_theta
+                            best_theta = theta if flip == 0 else np.float32(
+                                _flow_rotation(target_angle, source_angle, cand_frame, cx, cy, tx, ty, True)
+                            )
                             best_error = cand_error
                             best_total = cand_error + cand_penalty
                             accept_below = best_total * keep_factor

@@ -4,7 +4,9 @@ import numpy as np
 import pytest
 
 from fluidymation.engine.nnf import NNF
-from fluidymation.engine.patch_cost import _is_plain_window, _plain_window_cost, build_patch_cost, patch_errors
+from fluidymation.engine.patch_cost import (
+    _flow_pair_cost, _is_plain_window, _plain_window_cost, _rotated_cost, build_patch_cost, patch_errors,
+)
 from tests.naive import naive_bilinear, naive_patch_cost, naive_rotate
 
 
@@ -127,3 +129,28 @@ def test_plain_window_cost_matches_naive_cost_inside_both_images():
 def test_opposite_guide_must_be_a_swap():
     with pytest.raises(ValueError, match="swap"):
         make_cost(np.random.default_rng(8), guide_weights=(2.0, 2.0), opposite_guide=[1, 1])
+
+
+def test_flow_pair_cost_is_both_flow_aligned_angles():
+    """One pass over shared samples gives θ's cost unswapped and θ + π's swapped, with the
+    orientation term, as two rotated costs would."""
+    rng = np.random.default_rng(12)
+    source_angle = rng.uniform(-3, 3, (2, 9, 10)).astype(np.float32)
+    target_angle = rng.uniform(-3, 3, (7, 8)).astype(np.float32)
+    cost, *_ = make_cost(rng, guide_weights=(2.0, 2.0), opposite_guide=[1, 0], source_angle=source_angle,
+                         target_angle=target_angle, orientation_weight=0.5, orientation_clamp=3.0)
+    kernel_cost = cost.kernel_cost()
+    for frame, x, y, theta, tx, ty in [(1, 5.0, 4.0, 0.7, 3, 3), (0, 2.0, 6.0, -2.1, 0, 6), (1, 8.0, 1.0, 3.0, 7, 0)]:
+        cos_t, sin_t = np.float32(np.cos(theta)), np.float32(np.sin(theta))
+        first, second = _flow_pair_cost(kernel_cost, tx, ty, frame, np.float32(x), np.float32(y), np.float32(theta),
+                                        cos_t, sin_t, np.float32(np.inf))
+        unswapped = _rotated_cost(kernel_cost, tx, ty, frame, np.float32(x), np.float32(y), np.float32(theta),
+                                  cos_t, sin_t, False, np.float32(np.inf))
+        swapped = _rotated_cost(kernel_cost, tx, ty, frame, np.float32(x), np.float32(y), np.float32(theta + np.pi),
+                                -cos_t, -sin_t, True, np.float32(np.inf))
+        assert first == pytest.approx(unswapped, rel=1e-5)
+        assert second == pytest.approx(swapped, rel=1e-5)
+        assert first != pytest.approx(second, rel=1e-3)
+        stopped_first, stopped_second = _flow_pair_cost(kernel_cost, tx, ty, frame, np.float32(x), np.float32(y),
+                                                        np.float32(theta), cos_t, sin_t, np.float32(0.0))
+        assert 0.0 < stopped_first < first and 0.0 < stopped_second < second  # both stop early
