@@ -145,7 +145,7 @@ def run_case(name, profile, window=None, stored=None, changed=()):
         guides.compute_guides(mask, frame_count, params=guide_params, cache_dir=folder / "target")
         guide_seconds = time.perf_counter() - started
         rss = [("before the stage", *peak_and_current_rss_mib())]
-        times = []
+        times, cpu_times = [], []
         profiler = None
         if profile:
             import cProfile
@@ -153,12 +153,13 @@ def run_case(name, profile, window=None, stored=None, changed=()):
             profiler = cProfile.Profile()
             profiler.enable()
         loads = [os.getloadavg()[0]]
-        started = time.perf_counter()
+        started, cpu_started = time.perf_counter(), time.process_time()
         for done, _ in enumerate(stylize.stylize_sequence(mask, frame_count, source, params=params,
                                                           guide_params=guide_params, cache_dir=folder / "target"),
                                  start=1):
             times.append(time.perf_counter() - started)
-            started = time.perf_counter()
+            cpu_times.append(time.process_time() - cpu_started)
+            started, cpu_started = time.perf_counter(), time.process_time()
             if done % RSS_EVERY == 0:
                 rss.append((f"frame {done}", *peak_and_current_rss_mib()))
         loads.append(os.getloadavg()[0])
@@ -167,7 +168,8 @@ def run_case(name, profile, window=None, stored=None, changed=()):
 
             profiler.disable()
             pstats.Stats(profiler, stream=sys.stderr).sort_stats("cumulative").print_stats(30)
-    print(json.dumps({"warm_up": warm_up, "guides": guide_seconds, "times": times, "masked": masked, "rss": rss,
+    print(json.dumps({"warm_up": warm_up, "guides": guide_seconds, "times": times, "cpu_times": cpu_times,
+                      "masked": masked, "rss": rss,
                       "peak": peak_and_current_rss_mib()[0], "loads": loads}))
 
 
@@ -186,6 +188,7 @@ def run_child(name, threads, profile, window=None, stored=None, changed=()):
 def report(name, figures, threads, window=None):
     (width, height), frame_count, (ex_width, ex_height, ex_frames), _ = CASES[name]
     times = np.array(figures["times"])
+    cpu_times = np.array(figures["cpu_times"])
     masked = np.array(figures["masked"], np.float64)
     later = times[1:] if len(times) > 1 else times
     held = "" if window is None else f" (source_window {window})"
@@ -195,12 +198,14 @@ def report(name, figures, threads, window=None):
     print(f"  warm-up (numba load/compile, tiny scene) {figures['warm_up']:.1f} s; target guides of all "
           f"{frame_count} frames {figures['guides']:.1f} s (the stage's first frame includes them)")
     paper = name == "speed"
-    print(f"  {'':24s} {'s/frame':>8s} {'µs/px/frame':>12s}" + (f" {'paper s/frame':>14s}" if paper else ""))
-    rows = (("first frame", times[:1], masked[:1]), ("later frames (mean)", later, masked[len(times) - len(later):]),
-            ("all frames (mean)", times, masked))
-    for label, seconds, pixels in rows:
-        per_pixel = (seconds / pixels).mean() * 1e6
-        print(f"  {label:24s} {seconds.mean():8.2f} {per_pixel:12.1f}"
+    # CPU s/frame: the process's CPU time over all threads, which leaves out time the shared
+    # machine gives to others, so it compares runs more steadily than the wall clock
+    print(f"  {'':24s} {'s/frame':>8s} {'µs/px/frame':>12s} {'CPU s/frame':>12s}"
+          + (f" {'paper s/frame':>14s}" if paper else ""))
+    first, rest = slice(0, 1), slice(len(times) - len(later), len(times))
+    for label, part in (("first frame", first), ("later frames (mean)", rest), ("all frames (mean)", slice(None))):
+        per_pixel = (times[part] / masked[part]).mean() * 1e6
+        print(f"  {label:24s} {times[part].mean():8.2f} {per_pixel:12.1f} {cpu_times[part].mean():12.2f}"
               + (f" {PAPER_SECONDS_PER_FRAME:14.2f}" if paper else ""))
     print(f"  peak RSS {figures['peak']:.0f} MiB ({figures['rss'][0][1]:.0f} before the stage); RSS (MiB) " + ", ".join(
         f"{label}: {now:.0f}" for label, _, now in figures["rss"]))
