@@ -7,9 +7,13 @@ from pathlib import Path
 
 
 def cache_dir() -> Path:
-    """The user cache folder: ``$FLUIDYMATION_CACHE``, else ``~/.cache/fluidymation``."""
+    """The user cache folder: ``$FLUIDYMATION_CACHE``, else ``$XDG_CACHE_HOME/fluidymation``, else
+    ``~/.cache/fluidymation``."""
     chosen = os.environ.get("FLUIDYMATION_CACHE")
-    return Path(chosen).expanduser() if chosen else Path.home() / ".cache" / "fluidymation"
+    if chosen:
+        return Path(chosen).expanduser()
+    base = os.environ.get("XDG_CACHE_HOME")
+    return (Path(base).expanduser() if base else Path.home() / ".cache") / "fluidymation"
 
 
 def exemplar_cache_dir() -> Path:

@@ -12,13 +12,13 @@ from __future__ import annotations
 
 import dataclasses
 import json
-import os
 from pathlib import Path
 
 import numpy as np
 from scipy import ndimage
 
 from fluidymation.errors import InputError
+from fluidymation.pipeline import paths
 from fluidymation.pipeline.presets import parse_size, preset_defaults, resolve_params
 from fluidymation.pipeline.progress import progress
 from fluidymation.stages import exemplar_builtin
@@ -42,7 +42,9 @@ def add_parser(subparsers) -> None:
     make.add_argument("--frames", type=int, metavar="N", help="number of frames")
     make.add_argument("--color", metavar="#RRGGBB", help="pigment colour")
     make.add_argument("--wetness", type=float, metavar="W", help="starting water, 0 to 1")
-    make.add_argument("--cache", metavar="DIR", help="cache folder (default: $XDG_CACHE_HOME/fluidymation/exemplars)")
+    make.add_argument("--cache", metavar="DIR",
+                      help="cache folder (default: the exemplars/ folder of the user cache render reads, "
+                           "$FLUIDYMATION_CACHE or ~/.cache/fluidymation)")
     make.add_argument("--no-cache", action="store_true", help="generate without reading or writing the cache")
     make.set_defaults(run=run_make)
     show = actions.add_parser("show", help="contact sheet of an exemplar folder: frames, mask outlines, flow",
@@ -52,11 +54,6 @@ def add_parser(subparsers) -> None:
     show.add_argument("-o", "--output", metavar="SHEET.png", required=True, help="the contact sheet to write")
     show.add_argument("--count", type=int, default=6, metavar="N", help="frames shown, evenly spaced (default 6)")
     show.set_defaults(run=run_show)
-
-
-def default_cache_dir() -> Path:
-    base = os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache"
-    return Path(base) / "fluidymation" / "exemplars"
 
 
 def run_list(args) -> int:
@@ -73,7 +70,7 @@ def run_list(args) -> int:
 def run_make(args) -> int:
     params = resolve_params(args.name, seed=args.seed, size=parse_size(args.size), frames=args.frames,
                             color=args.color, wetness=args.wetness)
-    cache_dir = None if args.no_cache else Path(args.cache) if args.cache else default_cache_dir()
+    cache_dir = None if args.no_cache else Path(args.cache) if args.cache else paths.exemplar_cache_dir()
     out_dir = Path(args.output)
     with progress(params.frames, f"simulate {params.preset}", quiet=args.quiet) as bar:
         exemplar = exemplar_builtin.make_builtin_exemplar(params, cache_dir=cache_dir, progress=bar.update)

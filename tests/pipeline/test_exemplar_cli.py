@@ -81,3 +81,28 @@ def test_resolve_params_takes_defaults_and_checks_types():
         resolve_params("crumble", seed=1.5)
     with pytest.raises(InputError, match="valid names"):
         resolve_params("sand")
+
+
+def test_make_caches_where_render_looks(cli, tmp_path, monkeypatch):
+    """`exemplar make` fills the user cache render reads ($FLUIDYMATION_CACHE), so a render after it
+    does not simulate the medium again."""
+    from fluidymation.pipeline import paths
+
+    monkeypatch.setenv("FLUIDYMATION_CACHE", str(tmp_path / "user-cache"))
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "xdg"))
+    code, _, err = cli("-q", "exemplar", "make", "crumble", "-o", tmp_path / "x", "--size", 24, "--frames", 3)
+    assert code == 0, err
+    assert paths.exemplar_cache_dir() == tmp_path / "user-cache" / "exemplars"
+    assert any(paths.exemplar_cache_dir().iterdir())
+    assert not (tmp_path / "xdg").exists()
+
+
+def test_user_cache_falls_back_to_xdg_then_home(tmp_path, monkeypatch):
+    from fluidymation.pipeline import paths
+
+    monkeypatch.delenv("FLUIDYMATION_CACHE", raising=False)
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "xdg"))
+    assert paths.cache_dir() == tmp_path / "xdg" / "fluidymation"
+    monkeypatch.delenv("XDG_CACHE_HOME")
+    monkeypatch.setenv("HOME", str(tmp_path / "home"))
+    assert paths.cache_dir() == tmp_path / "home" / ".cache" / "fluidymation"
