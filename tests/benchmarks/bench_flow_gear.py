@@ -20,7 +20,7 @@ Over the gear's body between the hub and the teeth (radius 30–58 px), for each
 
 from __future__ import annotations
 
-import sys
+import argparse
 from pathlib import Path
 
 import imageio.v3 as iio
@@ -45,7 +45,13 @@ def tangent_alignment(luminance: np.ndarray, tangent: np.ndarray, region: np.nda
 
 
 def main() -> None:
-    video = Path(sys.argv[1]) if len(sys.argv) > 1 else ROOT / "docs" / "examples" / "flow-gear.mp4"
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    default = ROOT / "docs" / "examples" / "flow-gear.mp4"
+    parser.add_argument("video", nargs="?", type=Path, default=default,
+                        help=f"the three-panel video make_examples.py flow-gear writes (default {default.relative_to(ROOT)})")
+    video = parser.parse_args().video
+    if not video.is_file():
+        parser.error(f"{video}: no such video")
     frames = iio.imread(video, plugin="pyav").astype(np.float32) / 255.0
     yy, xx = np.mgrid[:PANEL, :PANEL] + 0.5
     radius = np.hypot(xx - CENTRE, yy - CENTRE)
