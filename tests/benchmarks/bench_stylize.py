@@ -190,7 +190,6 @@ def report(name, figures, threads, window=None):
     times = np.array(figures["times"])
     cpu_times = np.array(figures["cpu_times"])
     masked = np.array(figures["masked"], np.float64)
-    later = times[1:] if len(times) > 1 else times
     held = "" if window is None else f" (source_window {window})"
     print(f"\n{name}: target {width}x{height} px, {frame_count} frames, {masked.mean():.0f} masked px/frame; "
           f"exemplar {ex_width}x{ex_height}x{ex_frames}{held}; {threads} thread{'s' * (threads > 1)}; load average "
@@ -202,8 +201,9 @@ def report(name, figures, threads, window=None):
     # machine gives to others, so it compares runs more steadily than the wall clock
     print(f"  {'':24s} {'s/frame':>8s} {'µs/px/frame':>12s} {'CPU s/frame':>12s}"
           + (f" {'paper s/frame':>14s}" if paper else ""))
-    first, rest = slice(0, 1), slice(len(times) - len(later), len(times))
-    for label, part in (("first frame", first), ("later frames (mean)", rest), ("all frames (mean)", slice(None))):
+    later = slice(1, None) if len(times) > 1 else slice(None)
+    rows = (("first frame", slice(0, 1)), ("later frames (mean)", later), ("all frames (mean)", slice(None)))
+    for label, part in rows:
         per_pixel = (times[part] / masked[part]).mean() * 1e6
         print(f"  {label:24s} {times[part].mean():8.2f} {per_pixel:12.1f} {cpu_times[part].mean():12.2f}"
               + (f" {PAPER_SECONDS_PER_FRAME:14.2f}" if paper else ""))
