@@ -6,6 +6,10 @@ footprint (nearest pixel of ``(x, y) + R(θ) d``) in frames ``i - r .. i + r``. 
 penalty of a candidate patch is ``weight · Σ_window Ω* / (n² ω*)`` with the budget
 ``ω* = n² (2r + 1) |T_seg| / |S_seg|`` of its segment; the window sum is taken over
 the unrotated n×n box around the candidate's centre.
+
+An unturned patch's footprint is the n×n box around its nearest pixel, so unturned patches
+(all of them in EbSynth-style synthesis) are counted once at that pixel and spread by box
+sums, parallel over rows; only turned ones are stamped pixel by pixel.
 """
 
 import math
@@ -36,18 +40,27 @@ def _bucket_by_frame(nnf_frame, frames):
 
 
 @parallel_kernel
-def _stamp(nnf_frame, nnf_coords, offsets, indices, patch_radius, out):
-    """Count the footprints of the patches matched in each frame, in that frame only."""
+def _stamp(nnf_frame, nnf_coords, offsets, indices, patch_radius, out, centres):
+    """Count the footprints of the patches matched in each frame, in that frame only: turned
+    patches stamped pixel by pixel into ``out``, unturned ones (whose footprint is the n×n box
+    around their nearest pixel) counted once at that pixel in ``centres``. Returns how many
+    patches went to ``centres``."""
     frames, height, width = out.shape
     target_width = nnf_frame.shape[1]
+    unturned = 0
     for frame in prange(frames):
         out[frame] = 0
+        centres[frame] = 0
         for k in range(offsets[frame], offsets[frame + 1]):
             ty = indices[k] // target_width
             tx = indices[k] % target_width
             x = nnf_coords[ty, tx, 0]
             y = nnf_coords[ty, tx, 1]
             theta = nnf_coords[ty, tx, 2]
+            if theta == 0.0:
+                centres[frame, int(math.floor(y + 0.5)), int(math.floor(x + 0.5))] += 1
+                unturned += 1
+                continue
             cos_t = math.cos(theta)
             sin_t = math.sin(theta)
             for dy in range(-patch_radius, patch_radius + 1):
@@ -56,6 +69,32 @@ def _stamp(nnf_frame, nnf_coords, offsets, indices, patch_radius, out):
                     py = int(math.floor(y + sin_t * dx + cos_t * dy + 0.5))
                     if 0 <= px < width and 0 <= py < height:
                         out[frame, py, px] += 1
+    return unturned
+
+
+@parallel_kernel
+def _box_sums(values, radius, out):
+    """``out[i, y, x] = Σ values[i, y − r .. y + r, x − r .. x + r]`` (pixels outside count 0),
+    parallel over rows: running sums along x, then 2r + 1 rows added along y."""
+    frames, height, width = values.shape
+    rows = np.empty_like(values)
+    for index in prange(frames * height):
+        frame = index // height
+        y = index % height
+        running = 0
+        for x in range(-radius, width + radius):
+            if x + radius < width:
+                running += values[frame, y, x + radius]
+            if x - radius - 1 >= 0:
+                running -= values[frame, y, x - radius - 1]
+            if 0 <= x < width:
+                rows[frame, y, x] = running
+    for index in prange(frames * height):
+        frame = index // height
+        y = index % height
+        out[frame, y] = 0
+        for row in range(max(0, y - radius), min(height, y + radius + 1)):
+            out[frame, y] += rows[frame, row]
 
 
 @parallel_kernel
@@ -91,8 +130,12 @@ def occurrence_map(nnf, *, source_shape, patch_size, frame_radius=0):
     """
     frames = int(source_shape[0])
     counts = np.empty(tuple(int(s) for s in source_shape), np.int32)
+    centres = np.empty_like(counts)
     offsets, indices = _bucket_by_frame(nnf.frame, frames)
-    _stamp(nnf.frame, nnf.coords, offsets, indices, patch_size // 2, counts)
+    if _stamp(nnf.frame, nnf.coords, offsets, indices, patch_size // 2, counts, centres):
+        boxes = np.empty_like(counts)
+        _box_sums(centres, patch_size // 2, boxes)
+        counts += boxes
     if frame_radius == 0:
         return counts
     out = np.empty_like(counts)
@@ -101,32 +144,18 @@ def occurrence_map(nnf, *, source_shape, patch_size, frame_radius=0):
 
 
 @parallel_kernel
-def _penalty(occurrence, source_segment, scale_per_label, radius, out):
-    frames, height, width = occurrence.shape
-    for frame in prange(frames):
-        rows = np.zeros((height, width), np.float32)
-        for y in range(height):
-            running = 0.0
-            for x in range(-radius, width + radius):
-                if x + radius < width:
-                    running += occurrence[frame, y, x + radius]
-                if x - radius - 1 >= 0:
-                    running -= occurrence[frame, y, x - radius - 1]
-                if 0 <= x < width:
-                    rows[y, x] = running
+def _scale_by_label(window_sums, source_segment, scale_per_label, out):
+    """``out = window_sums × scale_per_label[label]`` per voxel, 0 where the label is -1."""
+    frames, height, width = window_sums.shape
+    for index in prange(frames * height):
+        frame = index // height
+        y = index % height
         for x in range(width):
-            running = 0.0
-            for y in range(-radius, height + radius):
-                if y + radius < height:
-                    running += rows[y + radius, x]
-                if y - radius - 1 >= 0:
-                    running -= rows[y - radius - 1, x]
-                if 0 <= y < height:
-                    label = source_segment[frame, y, x]
-                    if 0 <= label < scale_per_label.shape[0]:
-                        out[frame, y, x] = running * scale_per_label[label]
-                    else:
-                        out[frame, y, x] = 0.0
+            label = source_segment[frame, y, x]
+            if 0 <= label < scale_per_label.shape[0]:
+                out[frame, y, x] = window_sums[frame, y, x] * scale_per_label[label]
+            else:
+                out[frame, y, x] = 0.0
 
 
 def budget_scales(*, source_segment, target_segment, patch_size, frame_radius, weight):
@@ -172,6 +201,8 @@ def uniformity_penalty(occurrence, *, source_segment, scales, patch_size):
     -------
     ndarray, shape (T, Hs, Ws), float32
     """
+    window_sums = np.empty_like(occurrence)
+    _box_sums(occurrence, patch_size // 2, window_sums)
     out = np.empty(occurrence.shape, np.float32)
-    _penalty(occurrence, np.ascontiguousarray(source_segment, np.int32), scales.astype(np.float32), patch_size // 2, out)
+    _scale_by_label(window_sums, np.ascontiguousarray(source_segment, np.int32), scales.astype(np.float32), out)
     return out

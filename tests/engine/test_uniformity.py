@@ -11,10 +11,21 @@ def test_occurrence_counts_rotated_cuboids():
     frame[2, 3] = -1
     coords = np.stack([rng.uniform(0, 11, (6, 7)), rng.uniform(0, 9, (6, 7)), rng.uniform(-3, 3, (6, 7))], 2)
     coords = coords.astype(np.float32)
+    # unturned patches (counted by box sums), some on the source's border, among turned ones
+    coords[::2, :, 2] = 0.0
+    coords[0, :4, :2] = [[0.0, 0.0], [11.0, 9.0], [0.4, 8.6], [10.5, 0.5]]
     field = NNF(frame, coords)
     for radius in (0, 2):
         got = occurrence_map(field, source_shape=(5, 10, 12), patch_size=5, frame_radius=radius)
         np.testing.assert_array_equal(got, naive_occurrence(frame, coords, (5, 10, 12), 5, radius))
+
+
+def test_occurrence_of_unturned_patches_alone():
+    frame = np.zeros((9, 8), np.int32)
+    yy, xx = np.mgrid[:9, :8]
+    coords = np.stack([xx * 1.5, yy * 1.0, np.zeros((9, 8))], 2).astype(np.float32)
+    got = occurrence_map(NNF(frame, coords), source_shape=(1, 9, 12), patch_size=3)
+    np.testing.assert_array_equal(got, naive_occurrence(frame, coords, (1, 9, 12), 3, 0))
 
 
 def test_penalty_is_the_scaled_window_sum_per_segment():
