@@ -73,8 +73,8 @@ def _stamp(nnf_frame, nnf_coords, offsets, indices, patch_radius, out, centres):
 
 
 @parallel_kernel
-def _box_sums(values, radius, out):
-    """``out[i, y, x] = Σ values[i, y − r .. y + r, x − r .. x + r]`` (pixels outside count 0),
+def _add_box_sums(values, radius, out):
+    """``out[i, y, x] += Σ values[i, y − r .. y + r, x − r .. x + r]`` (pixels outside count 0),
     parallel over rows: running sums along x, then 2r + 1 rows added along y."""
     frames, height, width = values.shape
     rows = np.empty_like(values)
@@ -92,7 +92,6 @@ def _box_sums(values, radius, out):
     for index in prange(frames * height):
         frame = index // height
         y = index % height
-        out[frame, y] = 0
         for row in range(max(0, y - radius), min(height, y + radius + 1)):
             out[frame, y] += rows[frame, row]
 
@@ -133,9 +132,7 @@ def occurrence_map(nnf, *, source_shape, patch_size, frame_radius=0):
     centres = np.empty_like(counts)
     offsets, indices = _bucket_by_frame(nnf.frame, frames)
     if _stamp(nnf.frame, nnf.coords, offsets, indices, patch_size // 2, counts, centres):
-        boxes = np.empty_like(counts)
-        _box_sums(centres, patch_size // 2, boxes)
-        counts += boxes
+        _add_box_sums(centres, patch_size // 2, counts)
     if frame_radius == 0:
         return counts
     out = np.empty_like(counts)
@@ -201,8 +198,8 @@ def uniformity_penalty(occurrence, *, source_segment, scales, patch_size):
     -------
     ndarray, shape (T, Hs, Ws), float32
     """
-    window_sums = np.empty_like(occurrence)
-    _box_sums(occurrence, patch_size // 2, window_sums)
+    window_sums = np.zeros_like(occurrence)
+    _add_box_sums(occurrence, patch_size // 2, window_sums)
     out = np.empty(occurrence.shape, np.float32)
     _scale_by_label(window_sums, np.ascontiguousarray(source_segment, np.int32), scales.astype(np.float32), out)
     return out
