@@ -7,6 +7,7 @@ in parallel must write disjoint slices so results do not depend on the thread co
 ``exact_kernel`` is a ``kernel`` without fastmath, for kernels whose results must not
 depend on where numpy happened to allocate their arrays (see its comment).
 ``prefetch`` asks the CPU to start loading an array element's cache line.
+``borrowed`` drops the reference counting of a serial kernel's arrays (see its docstring).
 ``threads_for`` runs the parallel kernels of small jobs on one thread.
 A kernel's disk cache is also keyed to the files of the kernels it calls from other modules.
 """
@@ -136,6 +137,44 @@ def prefetch(typingctx, array, index):
         return context.get_dummy_value()
 
     return types.void(array, index), codegen
+
+
+@intrinsic
+def borrowed(typingctx, value):
+    """``value``, an array or a tuple of arrays and scalars, with its arrays' reference counting dropped.
+
+    Numba counts references to every array a kernel passes on or stores, an atomic update of the
+    array's count each time; a kernel that calls non-inlined kernels in its innermost loop spends
+    much of its time there (a serial PatchMatch tile ran 2× slower than the same code as the
+    body of a ``prange`` loop, whose arrays numba hands over uncounted). Borrowed arrays have no
+    count (a null ``meminfo``), so LLVM deletes the updates. Only for arrays the caller keeps
+    alive while the kernel runs, and never returned from it.
+    """
+    if not _holds_arrays(value):
+        return None
+
+    def codegen(context, builder, signature, args):
+        return _without_meminfo(context, builder, signature.args[0], args[0])
+
+    return value(value), codegen
+
+
+def _holds_arrays(value_type):
+    if isinstance(value_type, types.Array):
+        return True
+    return isinstance(value_type, types.BaseTuple) and any(map(_holds_arrays, value_type))
+
+
+def _without_meminfo(context, builder, value_type, value):
+    if isinstance(value_type, types.Array):
+        array = context.make_array(value_type)(context, builder, value)
+        array.meminfo = cgutils.get_null_value(array.meminfo.type)
+        return array._getvalue()
+    if isinstance(value_type, types.BaseTuple):
+        for index, element_type in enumerate(value_type):
+            element = _without_meminfo(context, builder, element_type, builder.extract_value(value, index))
+            value = builder.insert_value(value, element, index)
+    return value
 
 
 #: Jobs over fewer pixels (64×64) run their parallel kernels on one thread: on the shared

@@ -34,7 +34,7 @@ import math
 import numpy as np
 from numba import prange
 
-from fluidymation.engine._jit import inline_kernel, kernel, parallel_kernel, prefetch
+from fluidymation.engine._jit import borrowed, inline_kernel, kernel, parallel_kernel, prefetch
 from fluidymation.engine.nnf import ROTATION_FLOW, _flow_rotation
 from fluidymation.engine.patch_cost import (
     _flow_pair_cost, _is_plain_window, _patch_cost, _plain_window_cost, _prefetch_window,
@@ -93,6 +93,13 @@ def _search_tile(
 ):
     """:func:`_search` on target rows ``y_begin..y_end−1`` (one tile). A serial kernel of its own: as the body of
     the parallel loop it took numba's parallel passes most of a minute to compile."""
+    (
+        cost, source_segment, target_segment, source_angle, target_angle, penalty, penalty_scale, keep_margin,
+        nnf_frame, nnf_coords, error, start_frame, start_coords,
+    ) = borrowed((
+        cost, source_segment, target_segment, source_angle, target_angle, penalty, penalty_scale, keep_margin,
+        nnf_frame, nnf_coords, error, start_frame, start_coords,
+    ))
     height, width = nnf_frame.shape
     frames, source_height, source_width = source_segment.shape
     high_x = np.float32(source_width - 1)
