@@ -2,7 +2,7 @@
 
 Run: ``NUMBA_CACHE_DIR=.numba-cache .venv/bin/python tests/benchmarks/bench_quality.py
 [--scenes translation still ...] [--media watercolor-bloom ...] [--scale K] [--exemplar-size N]
-[--true-motion] [--write-docs] [--record-baseline]``.
+[--seeds 0 1 2] [--true-motion] [--write-docs] [--record-baseline]``.
 
 Each scene is a layer of 12 frames drawn analytically here (soft 1-px edges) on a 128-px
 canvas, or K times larger with ``--scale``, stylized with the stylizer's defaults
@@ -15,6 +15,8 @@ command, the date and the load average to docs/quality.md and one contact sheet 
 to docs/quality/ (other sizes: docs/quality-<size>-<exemplar size>.md and its folder).
 ``--record-baseline`` stores this run's texture fidelity in docs/quality/baseline.json under
 its sizes: the "no worse than today" reference later runs of those sizes are checked against.
+``--seeds`` renders every scene once per stylizer seed: a single run's failing count moves by
+about ±2 with the seed alone (docs/stylize.md), so changes are compared over several.
 ``--true-motion`` gives the guides each scene's own motion in place of the masks' estimate,
 as ``flow: vector`` does for a vector input (printed only).
 """
@@ -286,8 +288,14 @@ def _number(value, digits=2) -> str:
     return "n/a" if value is None or np.isnan(value) else f"{value:.{digits}f}"
 
 
-def _cell(text: str, verdict) -> str:
-    return text if verdict is None else f"{text} {'P' if verdict else 'F'}"
+def _cell(text: str, verdicts: list) -> str:
+    """``text`` with P, or F and, over several seeds, how many of them failed (``F2/3``)."""
+    if verdicts[0] is None:
+        return text
+    failed = sum(not verdict for verdict in verdicts)
+    if not failed:
+        return f"{text} P"
+    return f"{text} F" if len(verdicts) == 1 else f"{text} F{failed}/{len(verdicts)}"
 
 
 def exemplar_row(medium: str, figures: dict) -> list[str]:
@@ -296,8 +304,11 @@ def exemplar_row(medium: str, figures: dict) -> list[str]:
             _number(1e3 * figures["still"]), "", "1", _number(figures["band_still"]), "", ""]
 
 
-def scene_row(name: str, figures: dict, reference: dict, baseline: float | None) -> list[str]:
-    verdict = verdicts(figures, reference, baseline)
+def scene_row(name: str, runs: list[dict], reference: dict, baseline: float | None) -> list[str]:
+    """The figures of the first seed's run; each check's verdicts over every seed's."""
+    figures = runs[0]
+    by_seed = [verdicts(run, reference, baseline) for run in runs]
+    verdict = {check: [seed[check] for seed in by_seed] for check in by_seed[0]}
     fidelity = _number(figures["fidelity"], 4) + ("" if baseline is None else f" ({baseline:.4f})")
     return [name,
             _cell(f"{_number(figures['profile'])}@{figures['profile_band']}", verdict["profile"]),
@@ -311,6 +322,22 @@ def scene_row(name: str, figures: dict, reference: dict, baseline: float | None)
             _cell(_number(figures["band_still"]), verdict["band/still"]),
             _cell(_number(figures["iou"], 3), verdict["IoU"]),
             _cell(fidelity, verdict["fidelity"])]
+
+
+def failure_summary(results, baseline: dict, seeds: list[int]) -> str:
+    """Failing checks per seed, and how many checks fail in every seed and in at least one."""
+    per_seed = np.zeros(len(seeds), int)
+    every = some = 0
+    for medium, reference, measured in results:
+        for name, runs in measured:
+            by_seed = [verdicts(run, reference, baseline.get(medium, {}).get(name)) for run in runs]
+            for check in by_seed[0]:
+                failed = np.array([seed[check] is False for seed in by_seed])
+                per_seed += failed
+                every += bool(failed.all())
+                some += bool(failed.any())
+    text = "failing checks: " + ", ".join(f"{count} (seed {seed})" for count, seed in zip(per_seed, seeds))
+    return text if len(seeds) == 1 else f"{text}; {every} fail in every seed, {some} in at least one"
 
 
 def text_table(rows: list[list[str]]) -> str:
@@ -364,7 +391,7 @@ def curves_table(results) -> str:
     """Markdown: every profile curve (exemplar and scenes), one row each."""
     lines = ["| | " + " | ".join(str(k) for k in range(1, CURVE_BANDS + 1)) + " |", "|---|" + "---|" * CURVE_BANDS]
     for medium, reference, measured in results:
-        for name, figures in [("exemplar", reference)] + measured:
+        for name, figures in [("exemplar", reference)] + [(name, runs[0]) for name, runs in measured]:
             values = " | ".join("" if np.isnan(v) else f"{v:.2f}" for v in figures["profile_curve"])
             lines.append(f"| {medium} {name} | {values} |")
     return "\n".join(lines)
@@ -396,7 +423,7 @@ class Setup(NamedTuple):
 
 
 def write_docs(setup: Setup, command: str, loads: tuple, started: str, seconds: float, rows: list[list[str]],
-               results, scenes, media) -> None:
+               summary: str, results, scenes, media) -> None:
     size, exemplar_size = setup.canvas.size, setup.exemplar_size
     sheets = "\n".join(f"- {scene.name} ({scene.description}): ![{scene.name}]({setup.sheets.name}/{sheet_name(scene)})"
                        for scene in scenes)
@@ -415,7 +442,10 @@ configs/exemplars.yaml). Media: {', '.join(media)}.
 
 {markdown_table(rows)}
 
-P/F: issue 15's thresholds; n/a: the scene has no such region (no still region: the still-region
+{summary[0].upper() + summary[1:]}.
+
+P/F: issue 15's thresholds (over several seeds, F2/3: failed with two of three; the figures are the
+first seed's); n/a: the scene has no such region (no still region: the still-region
 and band/still figures; no moving edge: the band). The exemplar row of each medium holds the
 exemplar's own values, computed on its frames and masks.
 
@@ -511,6 +541,9 @@ def main():
                         help="a stylizer parameter instead of its default (YAML value; repeatable)")
     parser.add_argument("--guide", action="append", default=[], metavar="NAME=VALUE",
                         help="a guides parameter instead of its default (YAML value; repeatable)")
+    parser.add_argument("--seeds", nargs="+", type=int, metavar="SEED",
+                        help="render every scene with each of these stylizer seeds (default: the stylizer's); the table "
+                             "shows the first seed's figures and, per check, how many seeds failed it (F2/3)")
     parser.add_argument("--true-motion", action="store_true",
                         help="guides from each scene's own motion instead of the masks' estimate (printed only)")
     args = parser.parse_args()
@@ -524,6 +557,9 @@ def main():
     clock, load_start = time.perf_counter(), os.getloadavg()
     print(f"{command}\nload average {load_start[0]:.2f} {load_start[1]:.2f} {load_start[2]:.2f}", flush=True)
     params = dataclasses.replace(default_params(get_stylizer("fluidymation")), **overrides(args.param))
+    seeds = args.seeds or [params.seed]
+    if args.record_baseline and len(seeds) > 1:
+        raise SystemExit("--record-baseline takes one seed")
     guide_params = guides.Params(**overrides(args.guide))
     baselines = json.loads(BASELINE.read_text()) if BASELINE.is_file() else {}
     baseline = baselines.setdefault(setup.key, {})
@@ -534,34 +570,40 @@ def main():
             exemplar = load_exemplar(medium, setup.exemplar_size, workdir, guide_params)
             results.append((medium, exemplar.figures, []))
             for scene in scenes:
-                begun = time.perf_counter()
-                figures, output = measure(scene, exemplar, params, guide_params, workdir / medium / scene.name,
-                                          args.true_motion)
-                results[-1][2].append((scene.name, figures))
-                sheet_rows[scene.name].append((exemplar.rgb, output))
-                print(f"{medium} / {scene.name}: {time.perf_counter() - begun:.1f} s", file=sys.stderr, flush=True)
+                runs = []
+                for index, seed in enumerate(seeds):
+                    begun = time.perf_counter()
+                    figures, output = measure(scene, exemplar, dataclasses.replace(params, seed=seed), guide_params,
+                                              workdir / medium / scene.name / str(seed), args.true_motion)
+                    runs.append(figures)
+                    if index == 0:
+                        sheet_rows[scene.name].append((exemplar.rgb, output))
+                    print(f"{medium} / {scene.name} / seed {seed}: {time.perf_counter() - begun:.1f} s",
+                          file=sys.stderr, flush=True)
+                results[-1][2].append((scene.name, runs))
     if args.record_baseline:
         for medium, _, measured in results:
-            baseline.setdefault(medium, {}).update({name: figures["fidelity"] for name, figures in measured})
+            baseline.setdefault(medium, {}).update({name: runs[0]["fidelity"] for name, runs in measured})
         BASELINE.parent.mkdir(parents=True, exist_ok=True)
         BASELINE.write_text(json.dumps(baselines, indent=1, sort_keys=True) + "\n")
     rows = []
     for medium, reference, measured in results:
         rows.append(exemplar_row(medium, reference))
-        rows += [scene_row(f"  {name}", figures, reference, baseline.get(medium, {}).get(name))
-                 for name, figures in measured]
+        rows += [scene_row(f"  {name}", runs, reference, baseline.get(medium, {}).get(name))
+                 for name, runs in measured]
     loads = (load_start[0], os.getloadavg()[0])
     seconds = time.perf_counter() - clock
     print(text_table(rows))
     print("\nthresholds (issue 15, item 2):")
     for name, text in THRESHOLDS:
         print(f"  {name:10s} {text}")
-    print(f"\n{seconds:.0f} s; load average {loads[0]:.2f} -> {loads[1]:.2f}")
+    summary = failure_summary(results, baseline, seeds)
+    print(f"\n{summary}\n{seconds:.0f} s; load average {loads[0]:.2f} -> {loads[1]:.2f}")
     if args.write_docs:
         setup.sheets.mkdir(parents=True, exist_ok=True)
         for scene in scenes:
             contact_sheet(scene, sheet_rows[scene.name], setup.sheets / sheet_name(scene))
-        write_docs(setup, command, loads, started, seconds, rows, results, scenes, args.media)
+        write_docs(setup, command, loads, started, seconds, rows, summary, results, scenes, args.media)
 
 
 if __name__ == "__main__":
