@@ -304,11 +304,16 @@ def exemplar_row(medium: str, figures: dict) -> list[str]:
             _number(1e3 * figures["still"]), "", "1", _number(figures["band_still"]), "", ""]
 
 
+def seed_verdicts(runs: list[dict], reference: dict, baseline: float | None) -> dict:
+    """Per check, its verdict in each seed's run (:func:`verdicts`)."""
+    by_seed = [verdicts(run, reference, baseline) for run in runs]
+    return {check: [seed[check] for seed in by_seed] for check in by_seed[0]}
+
+
 def scene_row(name: str, runs: list[dict], reference: dict, baseline: float | None) -> list[str]:
     """The figures of the first seed's run; each check's verdicts over every seed's."""
     figures = runs[0]
-    by_seed = [verdicts(run, reference, baseline) for run in runs]
-    verdict = {check: [seed[check] for seed in by_seed] for check in by_seed[0]}
+    verdict = seed_verdicts(runs, reference, baseline)
     fidelity = _number(figures["fidelity"], 4) + ("" if baseline is None else f" ({baseline:.4f})")
     return [name,
             _cell(f"{_number(figures['profile'])}@{figures['profile_band']}", verdict["profile"]),
@@ -330,9 +335,8 @@ def failure_summary(results, baseline: dict, seeds: list[int]) -> str:
     every = some = 0
     for medium, reference, measured in results:
         for name, runs in measured:
-            by_seed = [verdicts(run, reference, baseline.get(medium, {}).get(name)) for run in runs]
-            for check in by_seed[0]:
-                failed = np.array([seed[check] is False for seed in by_seed])
+            for checked in seed_verdicts(runs, reference, baseline.get(medium, {}).get(name)).values():
+                failed = np.array([verdict is False for verdict in checked])
                 per_seed += failed
                 every += bool(failed.all())
                 some += bool(failed.any())
