@@ -14,6 +14,7 @@ A kernel's disk cache is also keyed to the files of the kernels it calls from ot
 
 import contextlib
 import os
+from concurrent.futures import ThreadPoolExecutor
 
 import numba
 from llvmlite import binding as llvm
@@ -198,3 +199,20 @@ def threads_for(pixels):
         yield
     finally:
         numba.set_num_threads(previous)
+
+
+_helpers = ThreadPoolExecutor(max_workers=max(1, numba.config.NUMBA_NUM_THREADS - 1), thread_name_prefix="kernel")
+
+
+def run_parts(serial_kernel, *args):
+    """``serial_kernel(*args, part, parts)`` for every ``part`` below ``parts``, one call per thread;
+    their results in the order of ``part``.
+
+    The kernel splits its work into fixed items and does items ``part, part + parts, …``, so
+    the result does not depend on ``parts`` (the thread count :func:`threads_for` and
+    ``NUMBA_NUM_THREADS`` set). A serial kernel run this way needs none of the parallel
+    lowering a ``prange`` loop costs at compile time.
+    """
+    parts = numba.get_num_threads()
+    helpers = [_helpers.submit(serial_kernel, *args, part, parts) for part in range(1, parts)]
+    return [serial_kernel(*args, 0, parts)] + [helper.result() for helper in helpers]

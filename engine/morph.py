@@ -12,18 +12,17 @@ target pixels around the position it was matched to. The coherence half is
 from __future__ import annotations
 
 import numpy as np
-from numba import prange
 
-from fluidymation.engine._jit import kernel, parallel_kernel
+from fluidymation.engine._jit import kernel, run_parts
 from fluidymation.engine.nnf import NNF
 from fluidymation.engine.patch_cost import _patch_cost
 
 
-@parallel_kernel
-def _window_search(cost, source_segment, target_segment, centre, radius, nnf_frame, nnf_coords, error):
+@kernel
+def _window_search(cost, source_segment, target_segment, centre, radius, nnf_frame, nnf_coords, error, part, parts):
     height, width = nnf_frame.shape
     source_height, source_width = source_segment.shape[1], source_segment.shape[2]
-    for ty in prange(height):
+    for ty in range(part, height, parts):
         for tx in range(width):
             nnf_frame[ty, tx] = -1
             error[ty, tx] = np.inf
@@ -77,7 +76,7 @@ def window_search(cost, centre, radius):
         raise ValueError(f"centre and radius must be ({height}, {width}, 2) and ({height}, {width})")
     nnf = NNF.empty(height, width)
     error = np.empty((height, width), np.float32)
-    _window_search(cost.kernel_cost(), cost.source_segment, cost.target_segment,
+    run_parts(_window_search, cost.kernel_cost(), cost.source_segment, cost.target_segment,
                    np.ascontiguousarray(centre, np.float32), np.ascontiguousarray(radius, np.int64),
                    nnf.frame, nnf.coords, error)
     return nnf, error

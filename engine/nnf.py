@@ -13,9 +13,8 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from numba import prange
 
-from fluidymation.engine._jit import kernel, parallel_kernel
+from fluidymation.engine._jit import kernel, run_parts
 from fluidymation.engine.random import _key4, _random_below
 
 ROTATION_NONE = 0
@@ -88,16 +87,17 @@ def _flow_rotation(target_angle, source_angle, frame, x, y, tx, ty, flip):
     return theta
 
 
-@parallel_kernel
+@kernel
 def _fill_random(
     nnf_frame, nnf_coords, target_segment, source_segment, segment_offsets, segment_pixels,
     rotation_mode, target_angle, source_angle, seed, salt, replace_all,
+    part, parts,
 ):
     height, width = target_segment.shape
     source_height = source_segment.shape[1]
     source_width = source_segment.shape[2]
     labels = segment_offsets.shape[0] - 1
-    for ty in prange(height):
+    for ty in range(part, height, parts):
         for tx in range(width):
             label = target_segment[ty, tx]
             if label < 0:
@@ -180,18 +180,19 @@ def fill_random(nnf, *, target_segment, source_segment, seed, salt=0, replace_al
     if target_angle is None:
         target_angle = _empty_angles((1, 1))
         source_angle = _empty_angles((1, 1, 1))
-    _fill_random(
+    run_parts(
+        _fill_random,
         nnf.frame, nnf.coords, np.ascontiguousarray(target_segment, np.int32), np.ascontiguousarray(source_segment, np.int32),
         offsets, pixels, int(rotation_mode), target_angle, source_angle, int(seed), int(salt),
         bool(replace_all),
     )
 
 
-@parallel_kernel
-def _upscale(coarse_frame, coarse_coords, fine_frame, fine_coords, source_height, source_width):
+@kernel
+def _upscale(coarse_frame, coarse_coords, fine_frame, fine_coords, source_height, source_width, part, parts):
     height, width = fine_frame.shape
     coarse_height, coarse_width = coarse_frame.shape
-    for ty in prange(height):
+    for ty in range(part, height, parts):
         cy = min(ty // 2, coarse_height - 1)
         oy = (ty - 2 * cy) - 0.5
         for tx in range(width):
@@ -231,16 +232,16 @@ def upscale_nnf(nnf, *, target_shape, source_shape):
     NNF of size ``target_shape``.
     """
     fine = NNF.empty(*target_shape)
-    _upscale(nnf.frame, nnf.coords, fine.frame, fine.coords, int(source_shape[0]), int(source_shape[1]))
+    run_parts(_upscale, nnf.frame, nnf.coords, fine.frame, fine.coords, int(source_shape[0]), int(source_shape[1]))
     return fine
 
 
-@parallel_kernel
-def _downscale(fine_frame, fine_coords, steps, coarse_frame, coarse_coords, source_height, source_width):
+@kernel
+def _downscale(fine_frame, fine_coords, steps, coarse_frame, coarse_coords, source_height, source_width, part, parts):
     height, width = coarse_frame.shape
     fine_height, fine_width = fine_frame.shape
     block = 1 << steps
-    for cy in prange(height):
+    for cy in range(part, height, parts):
         keys = np.empty(block * block, np.int64)
         order_keys = np.empty(block * block, np.int64)
         thetas = np.empty(block * block, np.float32)
@@ -330,7 +331,7 @@ def downscale_nnf(nnf, *, steps, target_shape, source_shape):
             raise ValueError(f"steps=0 keeps the size: nnf is {nnf.shape}, target_shape {tuple(target_shape)}")
         return NNF(nnf.frame.copy(), nnf.coords.copy())
     coarse = NNF.empty(*target_shape)
-    _downscale(nnf.frame, nnf.coords, int(steps), coarse.frame, coarse.coords,
+    run_parts(_downscale, nnf.frame, nnf.coords, int(steps), coarse.frame, coarse.coords,
                int(source_shape[0]), int(source_shape[1]))
     return coarse
 

@@ -32,9 +32,8 @@ from dataclasses import dataclass, replace
 from typing import NamedTuple
 
 import numpy as np
-from numba import prange
 
-from fluidymation.engine._jit import inline_kernel, kernel, parallel_kernel, prefetch
+from fluidymation.engine._jit import inline_kernel, kernel, prefetch, run_parts
 from fluidymation.engine.sampling import _bilinear_setup
 
 _CODE = np.uint16
@@ -406,10 +405,10 @@ def _prefetch_window(cost, frame, x, y):
         prefetch(source_rows, row + last)
 
 
-@parallel_kernel
-def _evaluate(cost, nnf_frame, nnf_coords, out):
+@kernel
+def _evaluate(cost, nnf_frame, nnf_coords, out, part, parts):
     height, width = nnf_frame.shape
-    for ty in prange(height):
+    for ty in range(part, height, parts):
         for tx in range(width):
             frame = nnf_frame[ty, tx]
             if frame < 0:
@@ -819,9 +818,12 @@ def _channel_max(values):
     return values.reshape(-1, values.shape[-1]).max(axis=0, initial=-np.inf).astype(np.float64)
 
 
-@parallel_kernel
-def _quantize_rows(values, offset, scale, out, columns):
-    for i in prange(values.shape[0]):
+@kernel
+def _quantize_rows(values, offset, scale, out, columns, part, parts):
+    """Part ``part`` of ``parts`` contiguous blocks of rows (not every ``parts``-th row: neighbouring rows
+    share cache lines)."""
+    block = (values.shape[0] + parts - 1) // parts
+    for i in range(part * block, min(values.shape[0], (part + 1) * block)):
         for c in range(values.shape[1]):
             code = min(max((values[i, c] - offset[columns[c]]) * scale[columns[c]], 0.0), _CODE_MAX)
             out[i, columns[c]] = int(code + 0.5)
@@ -831,7 +833,7 @@ def _quantize(values, offset, scale, codes, columns):
     """Store channel c of ``values`` as ``round((value − offset) · scale)`` of feature
     ``columns[c]``, clipped to the code range, into ``codes`` (shape (..., F), C-contiguous)."""
     values = np.ascontiguousarray(values, np.float32)
-    _quantize_rows(values.reshape(-1, values.shape[-1]), offset, scale, codes.reshape(-1, codes.shape[-1]),
+    run_parts(_quantize_rows, values.reshape(-1, values.shape[-1]), offset, scale, codes.reshape(-1, codes.shape[-1]),
                    np.asarray(columns, np.int64))
 
 def patch_errors(cost, nnf):
@@ -842,5 +844,5 @@ def patch_errors(cost, nnf):
     ndarray, shape (H, W), float32; ``inf`` where the NNF has no match.
     """
     out = np.empty(nnf.shape, np.float32)
-    _evaluate(cost.kernel_cost(), nnf.frame, nnf.coords, out)
+    run_parts(_evaluate, cost.kernel_cost(), nnf.frame, nnf.coords, out)
     return out

@@ -6,19 +6,18 @@ formula assumes). A dimension of size s becomes ``(s + 1) // 2``; edges are clam
 """
 
 import numpy as np
-from numba import prange
 
-from fluidymation.engine._jit import parallel_kernel
+from fluidymation.engine._jit import kernel, run_parts
 
 _TAPS = (0.125, 0.375, 0.375, 0.125)
 
 
-@parallel_kernel
-def _downsample(image, out):
+@kernel
+def _downsample(image, out, part, parts):
     frames, height, width, channels = image.shape
     out_height = out.shape[1]
     out_width = out.shape[2]
-    for row in prange(frames * out_height):
+    for row in range(part, frames * out_height, parts):
         t = row // out_height
         y = row % out_height
         column = np.zeros((width, channels), dtype=np.float32)
@@ -60,7 +59,7 @@ def downsample(image):
     work = np.ascontiguousarray(work)
     frames, height, width, channels = work.shape
     out = np.empty((frames, (height + 1) // 2, (width + 1) // 2, channels), dtype=np.float32)
-    _downsample(work, out)
+    run_parts(_downsample, work, out)
     if ndim == 2:
         return out[0, :, :, 0]
     if ndim == 3:

@@ -17,18 +17,17 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import prange
 
-from fluidymation.engine._jit import parallel_kernel
+from fluidymation.engine._jit import kernel, run_parts
 from fluidymation.engine.nnf import NNF
 
 
-@parallel_kernel
+@kernel
 def _shift(frame_in, coords_in, target_motion, target_angle, source_ext_plus, source_ext_minus, source_angle, frame_out,
-           achieved):
+           achieved, part, parts):
     height, width = frame_in.shape
     frames, source_height, source_width = source_ext_plus.shape
-    for ty in prange(height):
+    for ty in range(part, height, parts):
         for tx in range(width):
             frame = frame_in[ty, tx]
             if frame < 0:
@@ -98,7 +97,8 @@ def shift_nnf(nnf, *, target_motion, target_angle, source_ext_plus, source_ext_m
         raise ValueError(f"source_ext_plus must have shape (T, Hs, Ws), got {source_shape}")
     frame_out = np.empty((height, width), np.int32)
     achieved = np.empty((height, width), np.float32)
-    _shift(
+    run_parts(
+        _shift,
         nnf.frame, nnf.coords, np.ascontiguousarray(target_motion, np.float32),
         np.ascontiguousarray(target_angle, np.float32), np.ascontiguousarray(source_ext_plus, np.float32),
         np.ascontiguousarray(source_ext_minus, np.float32), np.ascontiguousarray(source_angle, np.float32), frame_out,
@@ -107,13 +107,13 @@ def shift_nnf(nnf, *, target_motion, target_angle, source_ext_plus, source_ext_m
     return NNF(frame_out, nnf.coords.copy()), achieved
 
 
-@parallel_kernel
-def _modulation(frame_in, coords_in, target_dist, source_dist, previous_mask, lower, upper, out):
+@kernel
+def _modulation(frame_in, coords_in, target_dist, source_dist, previous_mask, lower, upper, out, part, parts):
     height, width = frame_in.shape
     source_height = source_dist.shape[1]
     source_width = source_dist.shape[2]
     span = upper - lower
-    for ty in prange(height):
+    for ty in range(part, height, parts):
         for tx in range(width):
             frame = frame_in[ty, tx]
             if frame < 0 or not previous_mask[ty, tx]:
@@ -159,7 +159,8 @@ def temporal_modulation(nnf, *, target_dist, source_dist, previous_mask, lower, 
     if np.ndim(source_dist) != 3:
         raise ValueError(f"source_dist must have shape (T, Hs, Ws), got {np.shape(source_dist)}")
     out = np.empty((height, width), np.float32)
-    _modulation(
+    run_parts(
+        _modulation,
         nnf.frame, nnf.coords, np.ascontiguousarray(target_dist, np.float32),
         np.ascontiguousarray(source_dist, np.float32), np.ascontiguousarray(previous_mask, np.bool_),
         np.float32(lower), np.float32(upper), out,
@@ -167,10 +168,10 @@ def temporal_modulation(nnf, *, target_dist, source_dist, previous_mask, lower, 
     return out
 
 
-@parallel_kernel
-def _transport(frame_in, coords_in, flow, turn, frame_out, coords_out, origin):
+@kernel
+def _transport(frame_in, coords_in, flow, turn, frame_out, coords_out, origin, part, parts):
     height, width = frame_in.shape
-    for ty in prange(height):
+    for ty in range(part, height, parts):
         for tx in range(width):
             # where the material now at (tx, ty) was in the previous frame
             px = tx - flow[ty, tx, 0]
@@ -224,5 +225,5 @@ def transport_nnf(nnf, flow):
     frame_out = np.empty((height, width), np.int32)
     coords_out = np.empty((height, width, 3), np.float32)
     origin = np.empty((height, width), np.int64)
-    _transport(nnf.frame, nnf.coords, flow, turn, frame_out, coords_out, origin)
+    run_parts(_transport, nnf.frame, nnf.coords, flow, turn, frame_out, coords_out, origin)
     return NNF(frame_out, coords_out), origin

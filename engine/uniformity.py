@@ -15,9 +15,8 @@ sums, parallel over rows; only turned ones are stamped pixel by pixel.
 import math
 
 import numpy as np
-from numba import prange
 
-from fluidymation.engine._jit import kernel, parallel_kernel
+from fluidymation.engine._jit import kernel, run_parts
 
 
 @kernel
@@ -39,16 +38,16 @@ def _bucket_by_frame(nnf_frame, frames):
     return offsets, indices
 
 
-@parallel_kernel
-def _stamp(nnf_frame, nnf_coords, offsets, indices, patch_radius, out, centres):
+@kernel
+def _stamp(nnf_frame, nnf_coords, offsets, indices, patch_radius, out, centres, part, parts):
     """Count the footprints of the patches matched in each frame, in that frame only: turned
     patches stamped pixel by pixel into ``out``, unturned ones (whose footprint is the n×n box
     around their nearest pixel) counted once at that pixel in ``centres``. Returns how many
-    patches went to ``centres``."""
+    patches of the frames ``part, part + parts, …`` went to ``centres``."""
     frames, height, width = out.shape
     target_width = nnf_frame.shape[1]
     unturned = 0
-    for frame in prange(frames):
+    for frame in range(part, frames, parts):
         out[frame] = 0
         centres[frame] = 0
         for k in range(offsets[frame], offsets[frame + 1]):
@@ -72,13 +71,19 @@ def _stamp(nnf_frame, nnf_coords, offsets, indices, patch_radius, out, centres):
     return unturned
 
 
-@parallel_kernel
 def _add_box_sums(values, radius, out):
     """``out[i, y, x] += Σ values[i, y − r .. y + r, x − r .. x + r]`` (pixels outside count 0),
     parallel over rows: running sums along x, then 2r + 1 rows added along y."""
-    frames, height, width = values.shape
     rows = np.empty_like(values)
-    for index in prange(frames * height):
+    run_parts(_running_row_sums, values, radius, rows)
+    run_parts(_add_row_sums, rows, radius, out)
+
+
+@kernel
+def _running_row_sums(values, radius, rows, part, parts):
+    """``rows[i, y, x] = Σ values[i, y, x − r .. x + r]``, for the rows ``part, part + parts, …``."""
+    frames, height, width = values.shape
+    for index in range(part, frames * height, parts):
         frame = index // height
         y = index % height
         running = 0
@@ -89,18 +94,24 @@ def _add_box_sums(values, radius, out):
                 running -= values[frame, y, x - radius - 1]
             if 0 <= x < width:
                 rows[frame, y, x] = running
-    for index in prange(frames * height):
+
+
+@kernel
+def _add_row_sums(rows, radius, out, part, parts):
+    """``out[i, y] += Σ rows[i, y − r .. y + r]``, for the rows ``part, part + parts, …``."""
+    frames, height, width = rows.shape
+    for index in range(part, frames * height, parts):
         frame = index // height
         y = index % height
         for row in range(max(0, y - radius), min(height, y + radius + 1)):
             out[frame, y] += rows[frame, row]
 
 
-@parallel_kernel
-def _sum_frames(counts, frame_radius, out):
+@kernel
+def _sum_frames(counts, frame_radius, out, part, parts):
     """``out[i] = Σ counts[i − r .. i + r]`` (frames outside the sequence count 0)."""
     frames, height, width = counts.shape
-    for y in prange(height):
+    for y in range(part, height, parts):
         running = np.zeros(width, np.int32)
         for frame in range(-frame_radius, frames + frame_radius):
             if frame + frame_radius < frames:
@@ -131,20 +142,20 @@ def occurrence_map(nnf, *, source_shape, patch_size, frame_radius=0):
     counts = np.empty(tuple(int(s) for s in source_shape), np.int32)
     centres = np.empty_like(counts)
     offsets, indices = _bucket_by_frame(nnf.frame, frames)
-    if _stamp(nnf.frame, nnf.coords, offsets, indices, patch_size // 2, counts, centres):
+    if sum(run_parts(_stamp, nnf.frame, nnf.coords, offsets, indices, patch_size // 2, counts, centres)):
         _add_box_sums(centres, patch_size // 2, counts)
     if frame_radius == 0:
         return counts
     out = np.empty_like(counts)
-    _sum_frames(counts, int(frame_radius), out)
+    run_parts(_sum_frames, counts, int(frame_radius), out)
     return out
 
 
-@parallel_kernel
-def _scale_by_label(window_sums, source_segment, scale_per_label, out):
+@kernel
+def _scale_by_label(window_sums, source_segment, scale_per_label, out, part, parts):
     """``out = window_sums × scale_per_label[label]`` per voxel, 0 where the label is -1."""
     frames, height, width = window_sums.shape
-    for index in prange(frames * height):
+    for index in range(part, frames * height, parts):
         frame = index // height
         y = index % height
         for x in range(width):
@@ -201,5 +212,5 @@ def uniformity_penalty(occurrence, *, source_segment, scales, patch_size):
     window_sums = np.zeros_like(occurrence)
     _add_box_sums(occurrence, patch_size // 2, window_sums)
     out = np.empty(occurrence.shape, np.float32)
-    _scale_by_label(window_sums, np.ascontiguousarray(source_segment, np.int32), scales.astype(np.float32), out)
+    run_parts(_scale_by_label, window_sums, np.ascontiguousarray(source_segment, np.int32), scales.astype(np.float32), out)
     return out

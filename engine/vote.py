@@ -4,31 +4,30 @@ source patch (rotated, bilinearly sampled) that overlaps it according to the NNF
 import math
 
 import numpy as np
-from numba import prange
 
-from fluidymation.engine._jit import parallel_kernel
+from fluidymation.engine._jit import kernel, run_parts
 from fluidymation.engine.sampling import _bilinear_setup
 
 
-@parallel_kernel
-def _turns(nnf_coords, box, out):
+@kernel
+def _turns(nnf_coords, box, out, part, parts):
     """cos θ and sin θ of every match in the box (a pixel is voted by n² patches: one sine each, not n²)."""
     y_begin, y_end, x_begin, x_end = box
-    for ty in prange(y_begin, y_end):
+    for ty in range(y_begin + part, y_end, parts):
         for tx in range(x_begin, x_end):
             theta = nnf_coords[ty, tx, 2]
             out[ty, tx, 0] = math.cos(theta)
             out[ty, tx, 1] = math.sin(theta)
 
 
-@parallel_kernel
-def _vote(source, nnf_frame, nnf_coords, turns, radius, box, out, coverage):
+@kernel
+def _vote(source, nnf_frame, nnf_coords, turns, radius, box, out, coverage, part, parts):
     height, width = nnf_frame.shape
     source_height = source.shape[1]
     source_width = source.shape[2]
     channels = source.shape[3]
     y_begin, y_end, x_begin, x_end = box
-    for ty in prange(y_begin, y_end):
+    for ty in range(y_begin + part, y_end, parts):
         total = np.zeros(channels, np.float32)
         for tx in range(x_begin, x_end):
             total[:] = 0.0
@@ -106,6 +105,6 @@ def vote(source, nnf, *, patch_size):
     box = (max(rows[0] - radius, 0), min(rows[-1] + radius + 1, height),
            max(columns[0] - radius, 0), min(columns[-1] + radius + 1, width))
     turns = np.empty((height, width, 2), np.float32)
-    _turns(nnf.coords, np.array(box, np.int64), turns)
-    _vote(source, nnf.frame, nnf.coords, turns, radius, np.array(box, np.int64), out, coverage)
+    run_parts(_turns, nnf.coords, np.array(box, np.int64), turns)
+    run_parts(_vote, source, nnf.frame, nnf.coords, turns, radius, np.array(box, np.int64), out, coverage)
     return out, coverage
