@@ -1,14 +1,15 @@
 """The one place that sets numba's compilation flags for every kernel.
 
-``kernel`` compiles serial code; ``parallel_kernel`` adds ``prange`` support;
-``inline_kernel`` is a ``kernel`` inlined into its callers. All are
+``kernel`` compiles serial code; ``inline_kernel`` is a ``kernel`` inlined into its
+callers; ``run_parts`` runs a kernel's share of the work on each of a few threads (the
+engine has no ``prange``: see its docstring). All are
 cached on disk (``NUMBA_CACHE_DIR`` selects where) and use fastmath. Kernels that run
-in parallel must write disjoint slices so results do not depend on the thread count.
+in parts must write disjoint slices so results do not depend on the thread count.
 ``exact_kernel`` is a ``kernel`` without fastmath, for kernels whose results must not
 depend on where numpy happened to allocate their arrays (see its comment).
 ``prefetch`` asks the CPU to start loading an array element's cache line.
 ``borrowed`` drops the reference counting of a serial kernel's arrays (see its docstring).
-``threads_for`` runs the parallel kernels of small jobs on one thread.
+``threads_for`` runs the kernels of small jobs on one thread.
 A kernel's disk cache is also keyed to the files of the kernels it calls from other modules.
 """
 
@@ -30,7 +31,7 @@ from fluidymation.engine import compiling
 def _optimize_with_own_copies(library, _optimize=codegen.CPUCodeLibrary._optimize_final_module):
     """Bind each library's calls to its own copies of the kernels it links in.
 
-    Numba links a copy of every called kernel (and of every ``prange`` body) into the
+    Numba links a copy of every called kernel into the
     caller's module as a weak (``linkonce_odr``, ``weak_odr``) definition and optimizes it again there; the
     JIT then binds a call to whichever definition of the name it loaded first: the callee's
     own code after a fresh compilation, the caller's copy when the caller comes from the disk
@@ -105,7 +106,6 @@ event.register("numba:compile", _CompileEvents())
 
 
 kernel = numba.njit(cache=True, fastmath=True, nogil=True)
-parallel_kernel = numba.njit(cache=True, fastmath=True, nogil=True, parallel=True)
 #: A ``kernel`` copied into each caller (no call with dozens of array fields per use;
 #: longer compilation): for small functions called in the innermost loops.
 inline_kernel = numba.njit(cache=True, fastmath=True, nogil=True, inline="always")
@@ -147,7 +147,7 @@ def borrowed(typingctx, value):
     Numba counts references to every array a kernel passes on or stores, an atomic update of the
     array's count each time; a kernel that calls non-inlined kernels in its innermost loop spends
     much of its time there (a serial PatchMatch tile ran 2× slower than the same code as the
-    body of a ``prange`` loop, whose arrays numba hands over uncounted). Borrowed arrays have no
+    body of a numba ``prange`` loop, whose arrays numba hands over uncounted). Borrowed arrays have no
     count (a null ``meminfo``), so LLVM deletes the updates. Only for arrays the caller keeps
     alive while the kernel runs, and never returned from it.
     """
@@ -178,7 +178,7 @@ def _without_meminfo(context, builder, value_type, value):
     return value
 
 
-#: Jobs over fewer pixels (64×64) run their parallel kernels on one thread: on the shared
+#: Jobs over fewer pixels (64×64) run their kernels on one thread: on the shared
 #: 2-core machine a parallel region waits for its slowest thread, which then often waits for
 #: a busy core (measured: a 38×32 PatchMatch pass 8.8 ms on two threads, 1.7 ms on one).
 #: Above 64×64 two threads pay: bench_synth's small job 2.25 s with this bound against 2.65 s
@@ -188,7 +188,7 @@ SERIAL_BELOW_PIXELS = 1 << 12
 
 @contextlib.contextmanager
 def threads_for(pixels):
-    """Within the block, parallel kernels use one thread when ``pixels < SERIAL_BELOW_PIXELS``
+    """Within the block, :func:`run_parts` uses one thread when ``pixels < SERIAL_BELOW_PIXELS``
     (results do not depend on the thread count)."""
     if pixels >= SERIAL_BELOW_PIXELS:
         yield
@@ -205,13 +205,15 @@ _helpers = ThreadPoolExecutor(max_workers=max(1, numba.config.NUMBA_NUM_THREADS 
 
 
 def run_parts(serial_kernel, *args):
-    """``serial_kernel(*args, part, parts)`` for every ``part`` below ``parts``, one call per thread;
-    their results in the order of ``part``.
+    """``serial_kernel(*args, part, parts)`` for every ``part`` below ``parts``, one call per thread
+    (``nogil`` kernels, so they run at once); their results in the order of ``part``.
 
-    The kernel splits its work into fixed items and does items ``part, part + parts, …``, so
-    the result does not depend on ``parts`` (the thread count :func:`threads_for` and
-    ``NUMBA_NUM_THREADS`` set). A serial kernel run this way needs none of the parallel
-    lowering a ``prange`` loop costs at compile time.
+    The kernel splits its work into fixed items (rows, tiles) and does items ``part, part +
+    parts, …``, so the result does not depend on ``parts``, the thread count that
+    :func:`threads_for`, ``numba.set_num_threads`` and ``NUMBA_NUM_THREADS`` set. This replaces
+    numba's ``prange``: its parallel lowering compiled again, per wrapper, the code of every
+    kernel the loop calls (half of a first run's compile time, docs/performance.md), and its
+    OpenMP threads spin for a while after each loop, taking a core from the next kernel.
     """
     parts = numba.get_num_threads()
     helpers = [_helpers.submit(serial_kernel, *args, part, parts) for part in range(1, parts)]

@@ -21,10 +21,11 @@ them; unrotated integer candidates of a plain cost go straight to the cost's row
 SSD, turned ones (flow-aligned synthesis) to its float32 rotated cost, the pair of
 flow-aligned angles to its shared-sample pair cost.
 
-Parallelism: the target is cut into fixed bands of rows (tiles), processed in parallel.
-Inside a tile, propagation reads the live field; across a tile border it reads the
-field as it was at the start of the pass (one-pass-delayed propagation), so results are
-the same for any number of threads.
+Parallelism: the target is cut into fixed bands of rows (tiles); each thread of
+:func:`~fluidymation.engine._jit.run_parts` takes every ``parts``-th tile. Inside a tile,
+propagation reads the live field; across a tile border it reads the field as it was at the
+start of the pass (one-pass-delayed propagation), so results are the same for any number
+of threads.
 """
 
 from __future__ import annotations

@@ -40,9 +40,8 @@ from types import SimpleNamespace
 
 import numba
 import numpy as np
-from numba import prange
 
-from fluidymation.engine._jit import parallel_kernel  # numba.njit(cache=True, parallel=True, ...), the engine's flags
+from fluidymation.engine._jit import kernel, run_parts  # the engine's numba flags and threads
 from fluidymation.engine.nnf import NNF, fill_random, merge_nnf, upscale_nnf
 from fluidymation.engine.patch_cost import _patch_cost, patch_errors, quantize_source, target_patch_cost
 from fluidymation.engine.patchmatch import patchmatch_pass
@@ -201,8 +200,8 @@ def guided_energy(inputs, image, *, patch_size=5, level_passes=8, restarts=4, re
         pixels = np.random.default_rng(seed).choice(height * width, size=min(exhaustive_pixels, height * width),
                                                     replace=False)
         exact = np.empty(pixels.size, np.float32)
-        _exhaustive_minimum(cost.kernel_cost(), (pixels % width).astype(np.int64), (pixels // width).astype(np.int64),
-                            exact)
+        run_parts(_exhaustive_minimum, cost.kernel_cost(), (pixels % width).astype(np.int64),
+                  (pixels // width).astype(np.int64), exact)
         found = error.ravel()[pixels].astype(np.float64)
         gap = float((found - exact).sum() / exact.sum())
     weights = np.concatenate([inputs.colour_weights, inputs.guide_weights]).astype(np.float64)
@@ -211,13 +210,13 @@ def guided_energy(inputs, image, *, patch_size=5, level_passes=8, restarts=4, re
     return energy * _EBSYNTH_SCALE, {name: value * _EBSYNTH_SCALE for name, value in stages.items()}, gap
 
 
-@parallel_kernel
-def _exhaustive_minimum(cost, xs, ys, out):
+@kernel
+def _exhaustive_minimum(cost, xs, ys, out, part, parts):
     """``out[k]``: the lowest cost over every integer, unturned source patch of frame 0 at target pixel
     ``(xs[k], ys[k])``, under the engine's own patch cost (its ``_patch_cost``, given the ``KernelCost``)."""
     source_height = cost.source.shape[1]
     source_width = cost.source.shape[2]
-    for k in prange(xs.shape[0]):
+    for k in range(part, xs.shape[0], parts):
         best = np.float32(np.inf)
         for sy in range(source_height):
             for sx in range(source_width):
