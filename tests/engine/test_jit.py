@@ -1,11 +1,13 @@
-"""engine/_jit.py's ``borrowed``: the same arrays, without reference counting, and nothing leaked."""
+"""engine/_jit.py's ``borrowed`` (the same arrays, without reference counting, and nothing leaked) and
+``run_parts`` (every item done once, by the part that owns it, on any thread count)."""
 
+import numba
 import numpy as np
 import pytest
 from numba.core.errors import TypingError
 from numba.core.runtime import _nrt_python, rtsys
 
-from fluidymation.engine._jit import borrowed, kernel
+from fluidymation.engine._jit import borrowed, kernel, run_parts
 
 
 @kernel
@@ -56,3 +58,26 @@ def test_borrowing_leaks_and_frees_nothing():
 def test_borrowed_refuses_values_without_arrays():
     with pytest.raises(TypingError):
         _borrow_scalar(1.0)
+
+
+@kernel
+def _mark_items(owner, part, parts):
+    """``owner[i] += part + 1`` for the items ``part, part + parts, …``; returns how many it did."""
+    done = 0
+    for index in range(part, owner.shape[0], parts):
+        owner[index] += part + 1
+        done += 1
+    return done
+
+
+@pytest.mark.parametrize("threads", [1, min(2, numba.config.NUMBA_NUM_THREADS)])
+def test_run_parts_does_every_item_once_per_part(threads):
+    previous = numba.get_num_threads()
+    numba.set_num_threads(threads)
+    try:
+        owner = np.zeros(7, np.int64)
+        done = run_parts(_mark_items, owner)
+    finally:
+        numba.set_num_threads(previous)
+    assert len(done) == threads and sum(done) == 7
+    assert owner.tolist() == [index % threads + 1 for index in range(7)]
