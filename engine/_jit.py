@@ -14,6 +14,7 @@ A kernel's disk cache is also keyed to the files of the kernels it calls from ot
 """
 
 import contextlib
+import importlib
 import os
 from concurrent.futures import ThreadPoolExecutor
 
@@ -23,7 +24,9 @@ from llvmlite import ir
 from numba import types
 from numba.core import caching, cgutils, codegen, event
 from numba.core.dispatcher import Dispatcher
+from numba.core.runtime import rtsys
 from numba.extending import intrinsic
+from numba.np import linalg
 
 from fluidymation.engine import compiling
 
@@ -90,6 +93,46 @@ def _file_stamp(path):
 
 
 caching.CacheImpl.__init__ = _key_cache_to_callees
+
+
+def _load_without_registries(cache, signature, target_context):
+    """numba's loading of a cached kernel, without first filling the compiler's registries.
+
+    Numba's loader first refreshes the target context: it imports and installs every typing
+    and lowering registry, which only a compilation reads (0.3 s of a cached ``synth``'s first
+    kernel call, docs/performance.md). Cached machine code needs only numba's runtime, whose
+    functions it calls. A compilation still refreshes the context itself (numba's compiler
+    does so before typing), so only processes that compile nothing skip it.
+    """
+    rtsys.initialize(target_context)
+    with cache._guard_against_spurious_io_errors():
+        return cache._load_overload(signature, target_context)
+
+
+caching.Cache.load_overload = _load_without_registries
+
+
+def _import_arraymath_without_blas():
+    """Import numba's array functions without importing scipy.linalg.
+
+    ``numba.np.arraymath`` imports scipy.linalg when it is first imported (0.3 s), only to set
+    a flag that picks BLAS or a plain loop for ``np.convolve`` and ``np.correlate``, which no
+    kernel calls; told there is no BLAS, it would pick the loop. ``np.dot`` and ``np.linalg``
+    look for BLAS when a kernel using them is compiled, and still find it.
+    """
+    ensure_blas = linalg.ensure_blas
+
+    def no_blas():
+        raise ImportError("the engine's kernels do not call BLAS (engine/_jit.py)")
+
+    linalg.ensure_blas = no_blas
+    try:
+        importlib.import_module("numba.np.arraymath")
+    finally:
+        linalg.ensure_blas = ensure_blas
+
+
+_import_arraymath_without_blas()
 
 
 class _CompileEvents(event.Listener):

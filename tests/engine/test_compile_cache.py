@@ -80,3 +80,31 @@ def test_editing_a_called_kernel_recompiles_its_callers(tmp_path):
     edited = callee.stat().st_mtime_ns + 2_000_000_000
     os.utime(callee, ns=(edited, edited))
     assert _run(cache, script, tmp_path) == "4.0"  # not the cached caller's copy of the old scale
+
+
+LOAD_THEN_COMPILE = textwrap.dedent("""
+    import sys
+    import numba
+    import numpy as np
+    from fluidymation.engine.pyramid import downsample
+
+    half = downsample(np.arange(64, dtype=np.float32).reshape(8, 8, 1))
+    print("registries" if "numba.np.npyimpl" in sys.modules else "no registries", "scipy.linalg" in sys.modules)
+
+    @numba.njit
+    def needs_registries(values):  # compiled here: ufuncs, reductions and strings need numba's registries
+        return np.sqrt(values).sum(), str(values.shape[0])
+
+    print(half.shape, needs_registries(np.full(4, 4.0)))
+""")
+
+
+def test_a_process_loading_cached_kernels_skips_the_compilers_registries_until_it_compiles(tmp_path):
+    """engine/_jit.py: loading from the cache fills none of numba's typing and lowering registries
+    and imports no scipy.linalg; a later compilation in the same process still works."""
+    cache = tmp_path / "numba-cache"
+    first = _run(cache, LOAD_THEN_COMPILE).splitlines()
+    assert first[0] == "registries False"  # compiled: numba's compiler filled the registries
+    loaded = _run(cache, LOAD_THEN_COMPILE).splitlines()
+    assert loaded[0] == "no registries False"
+    assert loaded[1] == first[1] == "(4, 4, 1) (8.0, '4')"
