@@ -51,7 +51,8 @@ def _blur_rows(image, taps, out):
         # the row extended by its end pixels, so the tap loop runs over contiguous memory
         padded = np.empty(width + 2 * radius, dtype=np.float32)
         padded[:radius] = image[y, 0]
-        padded[radius: radius + width] = image[y]
+        for x in range(width):
+            padded[radius + x] = image[y, x]
         padded[radius + width:] = image[y, width - 1]
         for x in range(width):
             out[y, x] = 0.0

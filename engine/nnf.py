@@ -16,6 +16,7 @@ import numpy as np
 
 from fluidymation.engine._jit import kernel, run_parts
 from fluidymation.engine.random import _key4, _random_below
+from fluidymation.engine.sorting import sort_prefix
 
 ROTATION_NONE = 0
 ROTATION_FLOW = 1
@@ -246,7 +247,7 @@ def _downscale(fine_frame, fine_coords, steps, coarse_frame, coarse_coords, sour
         order_keys = np.empty(block * block, np.int64)
         thetas = np.empty(block * block, np.float32)
         for cx in range(width):
-            count = 0
+            count = np.int64(0)  # not a literal 0: the sort would be compiled for it too
             for by in range(block):
                 ty = cy * block + by
                 if ty >= fine_height:
@@ -280,8 +281,9 @@ def _downscale(fine_frame, fine_coords, steps, coarse_frame, coarse_coords, sour
             if count == 0:
                 coarse_frame[cy, cx] = -1
                 continue
-            order_keys[:count] = keys[:count]
-            order_keys[:count].sort()
+            for k in range(count):
+                order_keys[k] = keys[k]
+            sort_prefix(order_keys, count)
             best_key = order_keys[0]
             best_run = 0
             run = 0

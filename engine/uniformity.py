@@ -104,7 +104,8 @@ def _add_row_sums(rows, radius, out, part, parts):
         frame = index // height
         y = index % height
         for row in range(max(0, y - radius), min(height, y + radius + 1)):
-            out[frame, y] += rows[frame, row]
+            for x in range(width):
+                out[frame, y, x] += rows[frame, row, x]
 
 
 @kernel
@@ -114,12 +115,13 @@ def _sum_frames(counts, frame_radius, out, part, parts):
     for y in range(part, height, parts):
         running = np.zeros(width, np.int32)
         for frame in range(-frame_radius, frames + frame_radius):
-            if frame + frame_radius < frames:
-                running += counts[frame + frame_radius, y]
-            if frame - frame_radius - 1 >= 0:
-                running -= counts[frame - frame_radius - 1, y]
-            if 0 <= frame < frames:
-                out[frame, y] = running
+            for x in range(width):
+                if frame + frame_radius < frames:
+                    running[x] += counts[frame + frame_radius, y, x]
+                if frame - frame_radius - 1 >= 0:
+                    running[x] -= counts[frame - frame_radius - 1, y, x]
+                if 0 <= frame < frames:
+                    out[frame, y, x] = running[x]
 
 
 def occurrence_map(nnf, *, source_shape, patch_size, frame_radius=0):

@@ -28,6 +28,7 @@ import numpy as np
 
 from fluidymation.engine._jit import kernel
 from fluidymation.engine.flow import harmonic_fill
+from fluidymation.engine.sorting import argsort_prefix
 
 
 _CLIP_MODES = ("add", "subtract", "intersect", "difference")
@@ -162,9 +163,10 @@ def _coverage(points, ring_starts, even_odd, out):
     total = points.shape[0]
     crossings = np.empty(total, np.float64)
     directions = np.empty(total, np.int64)
+    order = np.empty(total, np.int64)
     for row in range(height):
         y = row + 0.5
-        count = 0
+        count = np.int64(0)  # not a literal 0: the sort would be compiled for it too
         for ring in range(ring_starts.shape[0] - 1):
             first = ring_starts[ring]
             last = ring_starts[ring + 1]
@@ -180,7 +182,7 @@ def _coverage(points, ring_starts, even_odd, out):
                 count += 1
         if count == 0:
             continue
-        order = np.argsort(crossings[:count])
+        argsort_prefix(crossings, count, order)
         winding = 0
         for k in range(count - 1):
             winding += directions[order[k]]
