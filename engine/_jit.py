@@ -11,6 +11,11 @@ depend on where numpy happened to allocate their arrays (see its comment).
 ``borrowed`` drops the reference counting of a serial kernel's arrays (see its docstring).
 ``threads_for`` runs the kernels of small jobs on one thread.
 A kernel's disk cache is also keyed to the files of the kernels it calls from other modules.
+Loading a cached kernel skips the compiler's registries, and numba's array functions are
+imported without scipy.linalg (each saves a fraction of a second of every start).
+Kernels should not assign an array to a slice (``out[y] = row``, ``out[y] += row``): numba
+then compiles a formatted shape-mismatch error, seconds of string code on a first run; loops
+assign element by element. They sort with :mod:`fluidymation.engine.sorting`, not numba's sort.
 """
 
 import contextlib
