@@ -113,14 +113,15 @@ def _fill_random(
                 continue
             key = _key4(seed, salt, ty, tx)
             count = segment_offsets[label + 1] - segment_offsets[label]
-            flat = segment_pixels[segment_offsets[label] + _random_below(key, 0, count)]
+            flat = segment_pixels[segment_offsets[label] + _random_below(key, np.int64(0), count)]
             frame = flat // (source_height * source_width)
             rest = flat % (source_height * source_width)
             sy = rest // source_width
             sx = rest % source_width
             theta = 0.0
             if rotation_mode == ROTATION_FLOW:
-                theta = _flow_rotation(target_angle, source_angle, frame, sx, sy, tx, ty, _random_below(key, 1, 2) == 1)
+                flip = _random_below(key, np.int64(1), np.int64(2)) == 1  # int64s: no literal counter to compile for
+                theta = _flow_rotation(target_angle, source_angle, frame, sx, sy, tx, ty, flip)
             nnf_frame[ty, tx] = frame
             nnf_coords[ty, tx, 0] = sx
             nnf_coords[ty, tx, 1] = sy
