@@ -16,7 +16,7 @@ import numpy as np
 
 from fluidymation.engine._jit import kernel, run_parts
 from fluidymation.engine.random import _key4, _random_below
-from fluidymation.engine.sorting import sort_prefix
+from fluidymation.engine.sorting import argsort_prefix
 
 ROTATION_NONE = 0
 ROTATION_FLOW = 1
@@ -245,7 +245,7 @@ def _downscale(fine_frame, fine_coords, steps, coarse_frame, coarse_coords, sour
     block = 1 << steps
     for cy in range(part, height, parts):
         keys = np.empty(block * block, np.int64)
-        order_keys = np.empty(block * block, np.int64)
+        order = np.empty(block * block, np.int64)
         thetas = np.empty(block * block, np.float32)
         for cx in range(width):
             count = np.int64(0)  # not a literal 0: the sort would be compiled for it too
@@ -282,20 +282,18 @@ def _downscale(fine_frame, fine_coords, steps, coarse_frame, coarse_coords, sour
             if count == 0:
                 coarse_frame[cy, cx] = -1
                 continue
-            for k in range(count):
-                order_keys[k] = keys[k]
-            sort_prefix(order_keys, count)
-            best_key = order_keys[0]
+            argsort_prefix(keys, count, order)
+            best_key = keys[order[0]]
             best_run = 0
             run = 0
             for k in range(count):
-                if k > 0 and order_keys[k] == order_keys[k - 1]:
+                if k > 0 and keys[order[k]] == keys[order[k - 1]]:
                     run += 1
                 else:
                     run = 1
                 if run > best_run:
                     best_run = run
-                    best_key = order_keys[k]
+                    best_key = keys[order[k]]
             for k in range(count):
                 if keys[k] == best_key:
                     coarse_coords[cy, cx, 2] = thetas[k]

@@ -1,36 +1,12 @@
-"""Sorting inside kernels, without numba's own sort.
+"""Sorting inside kernels, without numba's own sort: :func:`argsort_prefix`.
 
 numba compiles its quicksort anew for every element type, about 1.6 s each on a first run
-(two of them made 3.3 s of the quick start's compilation, docs/performance.md). These heap
-sorts are a few lines and compile in a fraction of that. Kernels sort short runs with them
+(two of them made 3.3 s of the quick start's compilation, docs/performance.md). This heap
+sort is a few lines and compiles in a fraction of that. Kernels sort short runs with it
 (a block's keys, a scanline's crossings), where the sort's speed does not matter.
 """
 
 from fluidymation.engine._jit import inline_kernel, kernel
-
-
-@kernel
-def sort_prefix(values, count):
-    """Sort ``values[:count]`` in place, ascending."""
-    for start in range(count // 2 - 1, -1, -1):
-        _sift_down(values, start, count)
-    for end in range(count - 1, 0, -1):
-        values[0], values[end] = values[end], values[0]
-        _sift_down(values, 0, end)
-
-
-@inline_kernel
-def _sift_down(values, root, end):
-    while True:
-        child = 2 * root + 1
-        if child >= end:
-            return
-        if child + 1 < end and values[child] < values[child + 1]:
-            child += 1
-        if not values[root] < values[child]:
-            return
-        values[root], values[child] = values[child], values[root]
-        root = child
 
 
 @kernel
