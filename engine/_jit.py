@@ -13,13 +13,16 @@ depend on where numpy happened to allocate their arrays (see its comment).
 A kernel's disk cache is also keyed to the files of the kernels it calls from other modules.
 Loading a cached kernel skips the compiler's registries, and numba's array functions are
 imported without scipy.linalg (each saves a fraction of a second of every start).
+Processes sharing the disk cache save kernels into it one at a time.
 Kernels should not assign an array to a slice (``out[y] = row``, ``out[y] += row``): numba
 then compiles a formatted shape-mismatch error, seconds of string code on a first run; loops
 assign element by element. They sort with :mod:`fluidymation.engine.sorting`, not numba's sort.
 """
 
 import contextlib
+import fcntl
 import importlib
+import itertools
 import os
 from concurrent.futures import ThreadPoolExecutor
 
@@ -115,6 +118,31 @@ def _load_without_registries(cache, signature, target_context):
 
 
 caching.Cache.load_overload = _load_without_registries
+
+
+def _save_one_process_at_a_time(cache_file, key, data):
+    """numba's saving of a cache entry, under an exclusive lock of the kernel's index, data before index.
+
+    Numba names a new entry's data file by the first number its index does not list. Two processes
+    saving two signatures of one kernel at once (pytest's workers, a render and its compile helper,
+    :mod:`fluidymation.pipeline.warmup`) read the same index, took the same number, and the index
+    kept by the last writer then named the other signature's machine code. One at a time they take
+    different numbers; with the data written first, an index entry never names a file still missing.
+    """
+    with open(cache_file._index_path + ".lock", "ab") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        overloads = cache_file._load_index()
+        data_name = overloads.get(key)
+        if data_name is None:
+            taken = set(overloads.values())
+            data_name = next(name for name in map(cache_file._data_name, itertools.count(1)) if name not in taken)
+        cache_file._save_data(data_name, data)
+        if overloads.get(key) != data_name:
+            overloads[key] = data_name
+            cache_file._save_index(overloads)
+
+
+caching.IndexDataCacheFile.save = _save_one_process_at_a_time
 
 
 def _import_arraymath_without_blas():

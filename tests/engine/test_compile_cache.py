@@ -108,3 +108,36 @@ def test_a_process_loading_cached_kernels_skips_the_compilers_registries_until_i
     loaded = _run(cache, LOAD_THEN_COMPILE).splitlines()
     assert loaded[0] == "no registries False"
     assert loaded[1] == first[1] == "(4, 4, 1) (8.0, '4')"
+
+
+def test_two_processes_saving_two_signatures_of_one_kernel_at_once_keep_both(tmp_path, monkeypatch):
+    """engine/_jit.py: numba's cache saves one process at a time. Two views of one kernel's cache
+    files (as two processes hold) save two signatures at once: the first to read the index waits up
+    to 0.5 s for the other to read it too; unlocked, both then took data file 1."""
+    import threading
+
+    from numba.core import caching
+
+    import fluidymation.engine._jit  # noqa: F401 (installs the locked save)
+
+    views = [caching.IndexDataCacheFile(str(tmp_path), "kernel-1.py311", "stamp") for _ in range(2)]
+    other_read = threading.Event()
+    first_reader = threading.Lock()
+    load_index = caching.IndexDataCacheFile._load_index
+
+    def slow_load_index(view):
+        overloads = load_index(view)
+        if first_reader.acquire(blocking=False):
+            other_read.wait(0.5)
+        else:
+            other_read.set()
+        return overloads
+
+    monkeypatch.setattr(caching.IndexDataCacheFile, "_load_index", slow_load_index)
+    savers = [threading.Thread(target=view.save, args=(key, f"code of {key}")) for view, key in zip(views, "ab")]
+    for saver in savers:
+        saver.start()
+    for saver in savers:
+        saver.join()
+    monkeypatch.undo()
+    assert [views[0].load(key) for key in "ab"] == ["code of a", "code of b"]
