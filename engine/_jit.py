@@ -13,7 +13,8 @@ depend on where numpy happened to allocate their arrays (see its comment).
 A kernel's disk cache is also keyed to the files of the kernels it calls from other modules.
 Loading a cached kernel skips the compiler's registries, and numba's array functions are
 imported without scipy.linalg (each saves a fraction of a second of every start).
-Processes sharing the disk cache save kernels into it one at a time.
+Processes sharing the disk cache save kernels into it one at a time; ``compiled_elsewhere`` makes
+this one wait for, and load, the kernels another process is compiling.
 Kernels should not assign an array to a slice (``out[y] = row``, ``out[y] += row``): numba
 then compiles a formatted shape-mismatch error, seconds of string code on a first run; loops
 assign element by element. They sort with :mod:`fluidymation.engine.sorting`, not numba's sort.
@@ -114,10 +115,45 @@ def _load_without_registries(cache, signature, target_context):
     """
     rtsys.initialize(target_context)
     with cache._guard_against_spurious_io_errors():
-        return cache._load_overload(signature, target_context)
+        loaded = cache._load_overload(signature, target_context)
+        if loaded is None and _wait_if_compiled_elsewhere(cache._py_func.__module__):
+            loaded = cache._load_overload(signature, target_context)
+        return loaded
 
 
 caching.Cache.load_overload = _load_without_registries
+
+#: module name → the wait for the process compiling its kernels (:func:`compiled_elsewhere`)
+_compiling_elsewhere = {}
+
+
+@contextlib.contextmanager
+def compiled_elsewhere(modules, wait):
+    """Within the block, another process compiles the kernels of ``modules`` (module names) into the disk
+    cache, and ``wait()`` returns once it has finished (at once afterwards). A kernel of those modules that
+    the cache lacks first waits for it and is loaded from the cache; only a kernel it did not save (another
+    signature) is compiled here, so the two processes do not compile the same kernels at once.
+    """
+    _compiling_elsewhere.update(dict.fromkeys(modules, wait))
+    try:
+        yield
+    finally:
+        for module in modules:
+            _compiling_elsewhere.pop(module, None)
+
+
+def _wait_if_compiled_elsewhere(module):
+    """Wait for the process compiling ``module``'s kernels, if one does; whether one does."""
+    wait = _compiling_elsewhere.get(module)
+    if wait is None:
+        return False
+    wait()
+    return True
+
+
+def in_disk_cache(dispatcher):
+    """Whether numba's disk cache holds machine code of ``dispatcher`` (any signature) for its current source."""
+    return bool(dispatcher._cache._cache_file._load_index())
 
 
 def _save_one_process_at_a_time(cache_file, key, data):

@@ -80,20 +80,27 @@ class CompileNotice:
 
     Listen with :meth:`listen` (it does not load numba) and :meth:`close` when the command ends, which says
     how many kernels were compiled and how long compiling took (numba compiles one kernel at a time, the
-    kernels it calls inside it).
+    kernels it calls inside it), and how many a helper process compiled for it (pipeline/warmup.py).
     """
 
     def __init__(self, *, quiet: bool = False):
         self.quiet, self.bar, self.compiled = quiet, None, 0
         self.depth, self.since, self.seconds = 0, 0.0, 0.0
+        self.helper_compiled = 0
 
     def listen(self) -> CompileNotice:
         from fluidymation.engine import compiling
 
         compiling.listeners.append(self.heard)
+        compiling.helper_listeners.append(self.heard_helper)
         return self
 
-    def heard(self, kernel: str, started: bool) -> None:
+    def heard_helper(self, kernels: int, seconds: float) -> None:
+        """A helper process compiled ``kernels`` kernels for this one (pipeline/warmup.py)."""
+        self.helper_compiled += kernels
+
+    def heard(self, kernel: str | None, started: bool) -> None:
+        """``kernel`` (None: the wait for a helper compiling kernels, timed but not counted) starts or ends."""
         if self.bar is None:
             if not self.quiet and not _json_lines:
                 print("compiling kernels (first run only: they are kept in numba's disk cache)", file=sys.stderr,
@@ -107,18 +114,23 @@ class CompileNotice:
         self.depth -= 1
         if self.depth == 0:
             self.seconds += time.monotonic() - self.since
-        self.compiled += 1
-        self.bar.update()
+        if kernel is not None:
+            self.compiled += 1
+            self.bar.update()
 
     def close(self) -> None:
         from fluidymation.engine import compiling
 
         if self.heard in compiling.listeners:
             compiling.listeners.remove(self.heard)
+        if self.heard_helper in compiling.helper_listeners:
+            compiling.helper_listeners.remove(self.heard_helper)
         if self.bar is None:
             return
         self.bar.__exit__(None, None, None)
         if not self.quiet and not _json_lines:
             kernels = f"{self.compiled} kernel{'' if self.compiled == 1 else 's'}"
-            print(f"compiled {kernels} in {self.seconds:.0f} s", file=sys.stderr)
+            helper = (f"; a helper process compiled {self.helper_compiled} more alongside (the wait for it is in "
+                      f"the {self.seconds:.0f} s)" if self.helper_compiled else "")
+            print(f"compiled {kernels} in {self.seconds:.0f} s{helper}", file=sys.stderr)
         self.bar = None

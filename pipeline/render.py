@@ -39,6 +39,7 @@ from fluidymation.pipeline.progress import progress
 from fluidymation.pipeline.resolve import Plan, PlannedLayer
 from fluidymation.pipeline.scene_stages import SCENE_STAGES
 from fluidymation.pipeline.stage import LAYER, SCENE, Keys, Stage, stages_to_run
+from fluidymation.pipeline import warmup
 from fluidymation.stages import guides
 from fluidymation.stages.exemplar_store import StoredSource
 from fluidymation.stages.files import write_text
@@ -118,8 +119,12 @@ def render(plan: Plan, options: Options) -> Path:
     job_options = options if options.executor == LOCAL else dataclasses.replace(options, quiet=True)
     if options.executor == LOCAL and len(chosen) > 1:
         job_options = dataclasses.replace(job_options, jobs=1)  # the layers take the processes: their tasks run in them
-    results = run_jobs(render_layer, [(plan, job_options, layer.name) for layer in chosen],
-                       executor=options.executor, jobs=options.jobs)
+    here = options.executor == LOCAL and (options.jobs <= 1 or len(chosen) <= 1)  # the layers run in this process
+    stylizing = any(stage.name == "stylize" for stage in run.stages)
+    warm_ups = [(run.work(layer.name).stylizer, run.work(layer.name).stylize_params) for layer in chosen]
+    with warmup.alongside(warm_ups if here and stylizing else []):
+        results = run_jobs(render_layer, [(plan, job_options, layer.name) for layer in chosen],
+                           executor=options.executor, jobs=options.jobs)
     records = {}
     for layer, (record, entries) in zip(chosen, results):
         records[layer.name] = record

@@ -29,6 +29,8 @@ class FluidymationStylizer(Stylizer):
     Params = stylize_params.Params
     defaults = resources.files("fluidymation.configs").joinpath("fluidymation.yaml")
     writes_nnf = True
+    warm_up_modules = tuple(f"fluidymation.engine.{name}" for name in (
+        "nnf", "patch_cost", "patchmatch", "pyramid", "shiftnnf", "uniformity", "vote"))
     ablation = (
         ("full", ()),
         ("no bound", ("w_bound",)),

@@ -117,6 +117,9 @@ class Stylizer(ABC):
     writes_nnf: ClassVar[bool] = False
     #: The ablation study (``fluidymation ablate``): (label, parameters set to 0), the full energy first.
     ablation: ClassVar[tuple[tuple[str, tuple[str, ...]], ...]] = ()
+    #: The engine modules (``fluidymation.engine.…``) whose kernels :meth:`warm_up` compiles. A first render
+    #: (numba's disk cache empty) runs the warm-up in a helper process meanwhile (pipeline/warmup.py). Empty: none.
+    warm_up_modules: ClassVar[tuple[str, ...]] = ()
 
     @classmethod
     def parameter_names(cls) -> tuple[str, ...]:
@@ -138,3 +141,11 @@ class Stylizer(ABC):
     def resume_from(self, index: int, state: dict[str, np.ndarray]) -> Any:
         """``job.resume`` for continuing after frame ``index`` from its :meth:`frame_state`."""
         return index
+
+    def warm_up(self, params, folder: Path) -> None:
+        """Stylize a tiny made-up layer with ``params`` (scratch files in ``folder``), compiling the kernels
+        :meth:`stylize` runs (:mod:`fluidymation.stages.warm_up`; for an exemplar stylizer)."""
+        from fluidymation.stages.warm_up import tiny_job  # numerical code: not imported for checking a scene
+
+        for _ in self.stylize(tiny_job(folder), params):
+            pass

@@ -141,3 +141,43 @@ def test_two_processes_saving_two_signatures_of_one_kernel_at_once_keep_both(tmp
         saver.join()
     monkeypatch.undo()
     assert [views[0].load(key) for key in "ab"] == ["code of a", "code of b"]
+
+
+GATED = textwrap.dedent("""
+    import subprocess, sys
+    from numba.core import event
+    from fluidymation.engine import _jit
+
+    compiled, waits = [], []
+    class Heard(event.Listener):
+        def on_start(self, compilation):
+            compiled.append(compilation.data["args"])
+        def on_end(self, compilation):
+            pass
+    event.register("numba:compile", Heard())
+
+    def helper_compiles():  # the other process, run at the first wait: compiles double(float) into the cache
+        if not waits:
+            subprocess.run([sys.executable, "-c", "from gated import double; double(1.5)"], check=True)
+        waits.append(1)
+
+    import gated
+    print("cached before", _jit.in_disk_cache(gated.double))
+    with _jit.compiled_elsewhere(["gated"], helper_compiles):
+        print(gated.double(2.5), gated.double(3))  # float: the helper's; int: compiled here
+    print("cached after", _jit.in_disk_cache(gated.double), "waits", len(waits), "compiled here", compiled)
+""")
+
+
+def test_a_kernel_another_process_compiles_is_waited_for_and_loaded(tmp_path):
+    """engine/_jit.py's compiled_elsewhere: a cache miss of a kernel of the other process's modules waits for
+    it and loads what it saved; a signature it did not save is compiled here."""
+    (tmp_path / "gated.py").write_text("from fluidymation.engine._jit import kernel\n\n@kernel\n"
+                                       "def double(x):\n    return x * 2.0\n")
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "numba-cache"), PYTHONPATH=str(tmp_path))
+    done = subprocess.run([sys.executable, "-c", GATED], env=env, capture_output=True, text=True, check=True,
+                          cwd=tmp_path)
+    lines = done.stdout.strip().splitlines()
+    assert lines[0] == "cached before False"
+    assert lines[1] == "5.0 6.0"
+    assert lines[2] == "cached after True waits 2 compiled here [(int64,)]"

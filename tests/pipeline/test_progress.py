@@ -71,3 +71,19 @@ def test_compiling_time_counts_nested_compilations_once(capsys, monkeypatch):
         notice.heard(kernel, started)
     notice.close()
     assert "compiled 3 kernels in 4 s" in capsys.readouterr().err  # (13 − 10) + (21 − 20): work between is not compiling
+
+
+def test_the_wait_for_a_compiling_helper_is_timed_not_counted_and_its_kernels_are_told(capsys, monkeypatch):
+    from fluidymation.engine import compiling
+    from fluidymation.pipeline import progress
+
+    clock = iter([10.0, 12.0, 20.0, 29.0])
+    monkeypatch.setattr(progress.time, "monotonic", lambda: next(clock))
+    notice = progress.CompileNotice().listen()
+    compiling.notify("masks kernel", True)
+    compiling.notify("masks kernel", False)
+    compiling.notify(None, True)  # waiting for the helper (pipeline/warmup.py)
+    compiling.notify(None, False)
+    compiling.helper_finished(40, 25.0)
+    notice.close()
+    assert "compiled 1 kernel in 11 s; a helper process compiled 40 more alongside" in capsys.readouterr().err

@@ -1,0 +1,50 @@
+"""pipeline/warmup.py: a first render leaves its stylizer's kernels to a helper process."""
+
+import json
+import os
+import subprocess
+import sys
+import textwrap
+from pathlib import Path
+
+import pytest
+
+BLOB = Path(__file__).parents[2] / "examples" / "blob" / "blob.svg"
+
+RENDER_AND_RECORD = textwrap.dedent("""
+    import json, sys
+    from numba.core import event
+    from fluidymation.pipeline.cli import main
+
+    compiled = []
+    class Heard(event.Listener):
+        def on_start(self, compilation):
+            compiled.append(compilation.data["dispatcher"].py_func.__module__)
+        def on_end(self, compilation):
+            pass
+    event.register("numba:compile", Heard())
+    code = main(sys.argv[1:])
+    print(json.dumps({"code": code, "compiled": compiled}))
+""")
+
+
+def _render(tmp_path, *args):
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "numba-cache"), FLUIDYMATION_CACHE=str(tmp_path / "cache"))
+    done = subprocess.run([sys.executable, "-c", RENDER_AND_RECORD, "render", str(tmp_path / "scene.yaml"), *args],
+                          env=env, capture_output=True, text=True, cwd=tmp_path)
+    return json.loads(done.stdout.strip().splitlines()[-1]), done.stderr
+
+
+@pytest.mark.slow
+def test_a_first_render_waits_for_the_helper_and_loads_the_stylizers_kernels(tmp_path):
+    from fluidymation.stages.fluidymation_stylizer import FluidymationStylizer
+
+    (tmp_path / "scene.yaml").write_text(f"input: {BLOB}\nfps: 12\nsize: [32, 32]\nframes: {{start: 0, end: 3}}\n"
+                                         "output: {dir: out}\nlayers:\n  - {name: blob}\n")
+    first, err = _render(tmp_path, "--until", "stylize")  # the background's synthesis would come after the helper
+    assert first["code"] == 0, err
+    assert "a helper process compiled" in err
+    assert first["compiled"]  # the masks' and guides' kernels, here
+    assert not set(first["compiled"]) & set(FluidymationStylizer.warm_up_modules)  # the helper compiled those
+    again, err = _render(tmp_path, "--until", "stylize", "--force")
+    assert again == {"code": 0, "compiled": []} and "helper" not in err
