@@ -14,6 +14,8 @@ docs/extending.md); a scene layer's ``stylizer:`` names one. Each brings:
   :class:`Frame`), one per frame as soon as it is done, given a :class:`StylizeJob`;
 * the format of its per-frame state, so an interrupted render continues from its last
   finished frame (:meth:`Stylizer.frame_state`, :meth:`Stylizer.resume_from`).
+* optionally, the engine modules whose kernels :meth:`Stylizer.warm_up` compiles, so a first
+  render compiles them in a helper process alongside (``warm_up_modules``).
 
 The exemplar comes from :mod:`fluidymation.stages.exemplar_store`.
 """
