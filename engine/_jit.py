@@ -161,7 +161,7 @@ def _save_one_process_at_a_time(cache_file, key, data):
 
     Numba names a new entry's data file by the first number its index does not list. Two processes
     saving two signatures of one kernel at once (pytest's workers, a render and its compile helper,
-    :mod:`fluidymation.pipeline.warmup`) read the same index, took the same number, and the index
+    :mod:`fluidymation.pipeline.compile_helper`) read the same index, took the same number, and the index
     kept by the last writer then named the other signature's machine code. One at a time they take
     different numbers; with the data written first, an index entry never names a file still missing.
     """

@@ -4,7 +4,7 @@
 ``(kernel_name, started)`` when numba starts (``started`` True) and ends compiling a
 kernel, not when it loads one from its disk cache; ``kernel_name`` None means this process
 starts or stops waiting for a helper process that compiles kernels for it
-(:mod:`fluidymation.pipeline.warmup`), which, when done, is reported to :data:`helper_listeners`
+(:mod:`fluidymation.pipeline.compile_helper`), which, when done, is reported to :data:`helper_listeners`
 as ``(kernels, seconds)``. The CLI listens, to say on a first run why it is slow (docs/performance.md).
 """
 

@@ -80,13 +80,13 @@ class CompileNotice:
 
     Listen with :meth:`listen` (it does not load numba) and :meth:`close` when the command ends, which says
     how many kernels were compiled and how long compiling took (numba compiles one kernel at a time, the
-    kernels it calls inside it), and how many a helper process compiled for it (pipeline/warmup.py).
+    kernels it calls inside it), and how many a helper process compiled for it (pipeline/compile_helper.py).
     """
 
     def __init__(self, *, quiet: bool = False):
         self.quiet, self.bar, self.compiled = quiet, None, 0
         self.depth, self.since, self.seconds = 0, 0.0, 0.0
-        self.helper_compiled = 0
+        self.helper_compiled, self.helper_seconds = 0, 0.0
 
     def listen(self) -> CompileNotice:
         from fluidymation.engine import compiling
@@ -96,8 +96,9 @@ class CompileNotice:
         return self
 
     def heard_helper(self, kernels: int, seconds: float) -> None:
-        """A helper process compiled ``kernels`` kernels for this one (pipeline/warmup.py)."""
+        """A helper process compiled ``kernels`` kernels for this one in ``seconds`` (pipeline/compile_helper.py)."""
         self.helper_compiled += kernels
+        self.helper_seconds += seconds
 
     def heard(self, kernel: str | None, started: bool) -> None:
         """``kernel`` (None: the wait for a helper compiling kernels, timed but not counted) starts or ends."""
@@ -130,7 +131,7 @@ class CompileNotice:
         self.bar.__exit__(None, None, None)
         if not self.quiet and not _json_lines:
             kernels = f"{self.compiled} kernel{'' if self.compiled == 1 else 's'}"
-            helper = (f"; a helper process compiled {self.helper_compiled} more alongside (the wait for it is in "
-                      f"the {self.seconds:.0f} s)" if self.helper_compiled else "")
+            helper = (f"; a helper process compiled {self.helper_compiled} more alongside in {self.helper_seconds:.0f} s "
+                      f"(the {self.seconds:.0f} s include waiting for it)" if self.helper_compiled else "")
             print(f"compiled {kernels} in {self.seconds:.0f} s{helper}", file=sys.stderr)
         self.bar = None

@@ -28,6 +28,7 @@ from functools import cached_property
 from pathlib import Path
 
 from fluidymation.errors import SceneError
+from fluidymation.pipeline import compile_helper
 from fluidymation.pipeline.cache import StageCache
 from fluidymation.pipeline.exemplars import layer_source, simulated_frame_count, stored_identity
 from fluidymation.pipeline.executors import LOCAL, run_jobs
@@ -39,7 +40,6 @@ from fluidymation.pipeline.progress import progress
 from fluidymation.pipeline.resolve import Plan, PlannedLayer
 from fluidymation.pipeline.scene_stages import SCENE_STAGES
 from fluidymation.pipeline.stage import LAYER, SCENE, Keys, Stage, stages_to_run
-from fluidymation.pipeline import warmup
 from fluidymation.stages import guides
 from fluidymation.stages.exemplar_store import StoredSource
 from fluidymation.stages.files import write_text
@@ -121,8 +121,9 @@ def render(plan: Plan, options: Options) -> Path:
         job_options = dataclasses.replace(job_options, jobs=1)  # the layers take the processes: their tasks run in them
     here = options.executor == LOCAL and (options.jobs <= 1 or len(chosen) <= 1)  # the layers run in this process
     stylizing = any(stage.name == "stylize" for stage in run.stages)
-    warm_ups = [(run.work(layer.name).stylizer, run.work(layer.name).stylize_params) for layer in chosen]
-    with warmup.alongside(warm_ups if here and stylizing else []):
+    warm_ups = [(run.work(layer.name).stylizer, run.work(layer.name).stylize_params)
+                for layer in chosen] if here and stylizing else []
+    with compile_helper.alongside(warm_ups):
         results = run_jobs(render_layer, [(plan, job_options, layer.name) for layer in chosen],
                            executor=options.executor, jobs=options.jobs)
     records = {}

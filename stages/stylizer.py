@@ -120,7 +120,7 @@ class Stylizer(ABC):
     #: The ablation study (``fluidymation ablate``): (label, parameters set to 0), the full energy first.
     ablation: ClassVar[tuple[tuple[str, tuple[str, ...]], ...]] = ()
     #: The engine modules (``fluidymation.engine.…``) whose kernels :meth:`warm_up` compiles. A first render
-    #: (numba's disk cache empty) runs the warm-up in a helper process meanwhile (pipeline/warmup.py). Empty: none.
+    #: (numba's disk cache empty) runs the warm-up in a helper process meanwhile (pipeline/compile_helper.py). Empty: none.
     warm_up_modules: ClassVar[tuple[str, ...]] = ()
 
     @classmethod

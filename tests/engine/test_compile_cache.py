@@ -7,6 +7,7 @@ And since the cached code holds those copies, a kernel's cache entry must go whe
 calls, in another file, changes.
 """
 
+import importlib
 import os
 import subprocess
 import sys
@@ -118,7 +119,7 @@ def test_two_processes_saving_two_signatures_of_one_kernel_at_once_keep_both(tmp
 
     from numba.core import caching
 
-    import fluidymation.engine._jit  # noqa: F401 (installs the locked save)
+    importlib.import_module("fluidymation.engine._jit")  # installs the locked save
 
     views = [caching.IndexDataCacheFile(str(tmp_path), "kernel-1.py311", "stamp") for _ in range(2)]
     other_read = threading.Event()

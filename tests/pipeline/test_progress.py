@@ -82,8 +82,9 @@ def test_the_wait_for_a_compiling_helper_is_timed_not_counted_and_its_kernels_ar
     notice = progress.CompileNotice().listen()
     compiling.notify("masks kernel", True)
     compiling.notify("masks kernel", False)
-    compiling.notify(None, True)  # waiting for the helper (pipeline/warmup.py)
+    compiling.notify(None, True)  # waiting for the helper (pipeline/compile_helper.py)
     compiling.notify(None, False)
     compiling.helper_finished(40, 25.0)
     notice.close()
-    assert "compiled 1 kernel in 11 s; a helper process compiled 40 more alongside" in capsys.readouterr().err
+    assert ("compiled 1 kernel in 11 s; a helper process compiled 40 more alongside in 25 s (the 11 s include "
+            "waiting for it)") in capsys.readouterr().err

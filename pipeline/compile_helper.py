@@ -4,7 +4,7 @@ Numba compiles one kernel at a time on one core. On a first run (numba's disk ca
 synthesis kernels alone took two thirds of the quick start's compile time (docs/performance.md).
 :func:`alongside` wraps the layers of a render: when a chosen layer's stylizer has a warm-up
 (:attr:`~fluidymation.stages.stylizer.Stylizer.warm_up_modules`) and the cache lacks the PatchMatch
-search, it starts ``python -m fluidymation.pipeline.warmup``, which runs that layer's stylizer with the
+search, it starts ``python -m fluidymation.pipeline.compile_helper``, which runs that layer's stylizer with the
 layer's parameters on a tiny made-up layer (:meth:`~fluidymation.stages.stylizer.Stylizer.warm_up`). It
 compiles into the disk cache on the second core while the render rasterizes the layers, computes their
 guides and simulates the exemplar. When the render needs a kernel of those modules that is not in the
@@ -39,7 +39,7 @@ class _Helper:
         environment = dict(os.environ, NUMBA_NUM_THREADS="1")  # its jobs are tiny: one thread, one core
         self.errors = tempfile.TemporaryFile()  # not a pipe: nobody reads it while the helper runs
         self.lock = threading.Lock()
-        self.process = subprocess.Popen([sys.executable, "-m", "fluidymation.pipeline.warmup"], env=environment,
+        self.process = subprocess.Popen([sys.executable, "-m", "fluidymation.pipeline.compile_helper"], env=environment,
                                         stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=self.errors)
         self.process.stdin.write(pickle.dumps((stylizer.name, params)))
         self.process.stdin.close()

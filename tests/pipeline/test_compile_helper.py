@@ -1,4 +1,4 @@
-"""pipeline/warmup.py: a first render leaves its stylizer's kernels to a helper process."""
+"""pipeline/compile_helper.py: a first render leaves its stylizer's kernels to a helper process."""
 
 import json
 import os
@@ -48,3 +48,29 @@ def test_a_first_render_waits_for_the_helper_and_loads_the_stylizers_kernels(tmp
     assert not set(first["compiled"]) & set(FluidymationStylizer.warm_up_modules)  # the helper compiled those
     again, err = _render(tmp_path, "--until", "stylize", "--force")
     assert again == {"code": 0, "compiled": []} and "helper" not in err
+
+
+def test_a_helper_that_fails_leaves_the_compiling_to_the_render(caplog):
+    import dataclasses
+    import logging
+
+    from fluidymation.engine import compiling
+    from fluidymation.pipeline import compile_helper
+    from fluidymation.pipeline.parameters import default_params
+    from fluidymation.pipeline.stylizers import get_stylizer
+
+    lazyfluids = get_stylizer("lazyfluids")
+    params = dataclasses.replace(default_params(lazyfluids), exemplar_frame=99)  # the tiny exemplar has 4 frames
+    heard = []
+    compiling.helper_listeners.append(lambda kernels, seconds: heard.append(kernels))
+    caplog.set_level(logging.DEBUG, logger="fluidymation")
+    helper = compile_helper._Helper(lazyfluids, params)
+    try:
+        helper.wait()
+        helper.wait()  # at once, the second time
+    finally:
+        helper.stop()
+        compiling.helper_listeners.pop()
+    assert helper.process.returncode != 0
+    assert "the lazyfluids kernel warm-up failed" in caplog.text and "exemplar_frame 99" in caplog.text
+    assert heard == []
