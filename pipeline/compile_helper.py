@@ -11,7 +11,8 @@ guides and simulates the exemplar. When the render needs a kernel of those modul
 cache yet, it waits for the helper and loads what the helper saved; a kernel the helper did not compile
 (another signature) it compiles itself (:func:`fluidymation.engine._jit.compiled_elsewhere`). Loaded or
 compiled here, a kernel gives the same bits (docs/engine.md). The helper is stopped when the render
-ends, finished or not.
+ends, finished or not; a helper that fails, or takes longer than :data:`WAIT_AT_MOST`, leaves the
+compiling to the render.
 """
 
 from __future__ import annotations
@@ -30,6 +31,9 @@ from pathlib import Path
 from fluidymation.stages.stylizer import Stylizer
 
 log = logging.getLogger(__name__)
+
+#: s the render waits for its helper at most (22–29 s in the runs of docs/performance.md)
+WAIT_AT_MOST = 600
 
 
 class _Helper:
@@ -55,9 +59,17 @@ class _Helper:
             if self.process.returncode is not None:
                 return
             compiling.notify(None, True)
-            output = self.process.stdout.read()
-            self.process.wait()
-            compiling.notify(None, False)
+            try:
+                self.process.wait(timeout=WAIT_AT_MOST)
+            except subprocess.TimeoutExpired:
+                self.process.kill()
+                self.process.wait()
+                log.debug("the %s kernel warm-up took over %g s; the render compiles the kernels itself", self.name,
+                          WAIT_AT_MOST)
+                return
+            finally:
+                compiling.notify(None, False)
+            output = self.process.stdout.read()  # one line: it fits the pipe while the helper runs
         if self.process.returncode != 0:
             self.errors.seek(0)
             log.debug("the %s kernel warm-up failed (%d); the render compiles them itself: %s", self.name,

@@ -74,3 +74,23 @@ def test_a_helper_that_fails_leaves_the_compiling_to_the_render(caplog):
     assert helper.process.returncode != 0
     assert "the lazyfluids kernel warm-up failed" in caplog.text and "exemplar_frame 99" in caplog.text
     assert heard == []
+
+
+def test_a_helper_that_takes_too_long_is_stopped_and_the_render_compiles(caplog, monkeypatch):
+    import logging
+
+    from fluidymation.pipeline import compile_helper
+    from fluidymation.pipeline.parameters import default_params
+    from fluidymation.pipeline.stylizers import get_stylizer
+
+    monkeypatch.setattr(compile_helper, "WAIT_AT_MOST", 0.05)  # less than the helper's start-up
+    caplog.set_level(logging.DEBUG, logger="fluidymation")
+    stylizer = get_stylizer("fluidymation")
+    helper = compile_helper._Helper(stylizer, default_params(stylizer))
+    try:
+        helper.wait()
+        helper.wait()
+    finally:
+        helper.stop()
+    assert helper.process.returncode != 0  # killed
+    assert "the fluidymation kernel warm-up took over 0.05 s" in caplog.text
