@@ -168,13 +168,12 @@ def _save_one_process_at_a_time(cache_file, key, data):
     with open(cache_file._index_path + ".lock", "ab") as lock:
         fcntl.flock(lock, fcntl.LOCK_EX)
         overloads = cache_file._load_index()
-        data_name = overloads.get(key)
-        if data_name is None:
+        new = key not in overloads
+        if new:
             taken = set(overloads.values())
-            data_name = next(name for name in map(cache_file._data_name, itertools.count(1)) if name not in taken)
-        cache_file._save_data(data_name, data)
-        if overloads.get(key) != data_name:
-            overloads[key] = data_name
+            overloads[key] = next(name for name in map(cache_file._data_name, itertools.count(1)) if name not in taken)
+        cache_file._save_data(overloads[key], data)
+        if new:
             cache_file._save_index(overloads)
 
 

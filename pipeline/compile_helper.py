@@ -53,8 +53,6 @@ class _Helper:
         """Wait for the helper to finish (at once if it has), then tell the compile listeners what it did."""
         from fluidymation.engine import compiling
 
-        if self.process.returncode is not None:
-            return
         with self.lock:  # kernels may be looked up on several threads
             if self.process.returncode is not None:
                 return
@@ -87,24 +85,20 @@ class _Helper:
         self.errors.close()
 
 
-def _needs_warm_up(stylizer: Stylizer) -> bool:
-    """Whether ``stylizer`` has a warm-up and numba's disk cache lacks the PatchMatch search."""
-    if not stylizer.warm_up_modules:
-        return False
-    from fluidymation.engine import _jit, patchmatch  # numerical code: only when rendering
-
-    return not _jit.in_disk_cache(patchmatch._search_tile)
-
-
 @contextlib.contextmanager
 def alongside(stylizers_and_params):
-    """Within the block, the first of the (stylizer, params) pairs that :func:`_needs_warm_up` is warmed up in a
-    helper process, and a kernel of its modules missing from the disk cache waits for it."""
-    chosen = next(((stylizer, params) for stylizer, params in stylizers_and_params if _needs_warm_up(stylizer)), None)
+    """Within the block, the first of the (stylizer, params) pairs whose stylizer has a warm-up is warmed up in a
+    helper process, unless numba's disk cache holds the PatchMatch search already; a kernel of its modules
+    missing from the disk cache waits for the helper."""
+    chosen = next(((stylizer, params) for stylizer, params in stylizers_and_params if stylizer.warm_up_modules), None)
     if chosen is None:
         yield
         return
-    from fluidymation.engine import _jit
+    from fluidymation.engine import _jit, patchmatch  # numerical code: only when rendering
+
+    if _jit.in_disk_cache(patchmatch._search_tile):
+        yield
+        return
 
     helper = _Helper(*chosen)
     log.debug("compiling the %s kernels in a helper process (pid %d)", helper.name, helper.process.pid)

@@ -121,8 +121,8 @@ def render(plan: Plan, options: Options) -> Path:
         job_options = dataclasses.replace(job_options, jobs=1)  # the layers take the processes: their tasks run in them
     here = options.executor == LOCAL and (options.jobs <= 1 or len(chosen) <= 1)  # the layers run in this process
     stylizing = any(stage.name == "stylize" for stage in run.stages)
-    warm_ups = [(run.work(layer.name).stylizer, run.work(layer.name).stylize_params)
-                for layer in chosen] if here and stylizing else []
+    works = [run.work(layer.name) for layer in chosen] if here and stylizing else []
+    warm_ups = [(work.stylizer, work.stylize_params) for work in works]
     with compile_helper.alongside(warm_ups):
         results = run_jobs(render_layer, [(plan, job_options, layer.name) for layer in chosen],
                            executor=options.executor, jobs=options.jobs)
