@@ -21,6 +21,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from fluidymation.engine._jit import exact_kernel, run_parts
+
 #: Quantiles kept per frame, segment and channel.
 QUANTILES = 64
 
@@ -90,69 +92,47 @@ def match_histograms(colour: np.ndarray, nnf_frame: np.ndarray, target_segment: 
     ndarray, shape (H, W, C), float32
         A new image.
     """
-    out = colour.copy()
+    colour = np.ascontiguousarray(colour, np.float32)
     frames, labels, channels, quantiles = tables.shape
-    matched = (nnf_frame >= 0) & (target_segment >= 0) & (target_segment < labels)
-    values = np.ascontiguousarray(out[matched].T)  # (C, N): one contiguous row per channel
-    own = target_segment[matched]
-    frames_used = nnf_frame[matched]
-    # each segment's own pixels take their ranks' values (ties keep distinct ranks); pixels
-    # without a remapping keep theirs
-    remapped = values.copy()
-    remappings = {}
-    for label in range(labels):
-        members = np.flatnonzero(own == label)
-        remapping = _segment_remapping(values[:, members], frames_used[members], tables[:, label])
-        if remapping is None:
-            continue
-        own_values = np.empty((values.shape[0], members.size), np.float32)
-        for channel, (order, wanted) in enumerate(remapping):
-            own_values[channel, order] = wanted
-        remapped[:, members] = own_values
-        remappings[label] = (members, remapping)
-    if blend is not None and remappings:
-        _blend_remappings(values, own, blend[:, matched], remappings, remapped)
-    out[matched] = (values + np.float32(strength) * (remapped - values)).T
+    pixels = np.flatnonzero((nnf_frame >= 0) & (target_segment >= 0) & (target_segment < labels))
+    own = target_segment.ravel()[pixels].astype(np.int64)
+    by_label = np.argsort(own, kind="stable")  # each segment's pixels, in image order
+    starts = np.concatenate([[0], np.cumsum(np.bincount(own, minlength=labels))]).astype(np.int64)
+    frames_used = nnf_frame.ravel()[pixels]
+    references = [_reference(frames_used[by_label[starts[label]:starts[label + 1]]], tables[:, label])
+                  for label in range(labels)]
+    has_reference = np.array([reference is not None for reference in references], bool)
+    longest = max([reference[0].shape[1] for reference in references if reference is not None], default=1)
+    levels = np.zeros((labels, channels, longest), np.float64)  # each reference's cumulative weights (ascending)
+    values_at = np.zeros((labels, channels, longest), np.float64)  # the pooled quantiles at those levels
+    lengths = np.zeros(labels, np.int64)
+    for label, reference in enumerate(references):
+        if reference is not None:
+            lengths[label] = reference[0].shape[1]
+            levels[label, :, :lengths[label]], values_at[label, :, :lengths[label]] = reference
+    flat = colour.reshape(-1, channels)
+    remapped = flat[pixels]  # segments without a reference keep their votes
+    ranked = np.empty((channels, pixels.size), np.float32)  # per segment run: its votes ascending ...
+    wanted = np.empty((channels, pixels.size), np.float32)  # ... and the values they move to
+    sizes = np.diff(starts)
+    tasks = np.array([(label, channel) for label in np.argsort(-sizes, kind="stable")
+                      if has_reference[label] and sizes[label] > 0 for channel in range(channels)], np.int64)
+    run_parts(_remap_segments, flat, pixels, by_label, starts, tasks.reshape(-1, 2), levels, values_at, lengths,
+              remapped, ranked, wanted)
+    if blend is not None and has_reference.any():
+        weights = np.ascontiguousarray(blend, np.float32).reshape(len(blend), -1)
+        run_parts(_blend_remappings, flat, pixels, own, weights, has_reference, starts, ranked, wanted, remapped)
+    out = colour.copy()
+    run_parts(_move_towards, out.reshape(-1, channels), pixels, remapped, np.float32(strength))
     return out
 
 
-def _blend_remappings(values, own, weights, remappings, remapped) -> None:
-    """Where a pixel takes some of another segment's remapping, mix them by ``weights`` (labels, N), in place.
+def _reference(frames_used: np.ndarray, table: np.ndarray):
+    """A segment's reference distribution, per channel, as (cumulative weights, pooled quantiles), both (C, P)
+    and ascending; None without one.
 
-    ``values`` and ``remapped`` are (C, N). The pixel's own remapping keeps its exact (rank)
-    value; another segment's is read as a function of the value. Only segments with a
-    remapping count."""
-    available = np.zeros(len(weights), bool)
-    available[list(remappings)] = True
-    weights = np.where(available[:, None], weights, 0.0).astype(np.float32)
-    own_weight = np.take_along_axis(weights, own[None].astype(np.int64), axis=0)[0]
-    zone = np.flatnonzero(weights.sum(axis=0) > own_weight)
-    if zone.size == 0:
-        return
-    own_weight = own_weight[zone]
-    mixed = own_weight * remapped[:, zone]
-    total = own_weight.copy()
-    for label, (members, remapping) in remappings.items():
-        weight = np.where(own[zone] != label, weights[label, zone], 0.0)
-        take = np.flatnonzero(weight > 0)
-        for channel, (order, wanted) in enumerate(remapping):
-            ranked = values[channel, members[order]]
-            mixed[channel, take] += weight[take] * np.interp(values[channel, zone[take]], ranked, wanted)
-        total += weight
-    has = total > 0
-    remapped[:, zone[has]] = mixed[:, has] / total[has]
-
-
-def _segment_remapping(values: np.ndarray, frames_used: np.ndarray, table: np.ndarray):
-    """Per channel, (the order that sorts the segment's votes, the values they move to in that order), or
-    None without a reference.
-
-    ``values`` is (C, n), the segment's votes; ``table`` its label's :func:`quantile_tables`
-    part, (T, C, QUANTILES); the reference is the mixture of the frames ``frames_used``
-    names, each weighted by its count."""
-    count = values.shape[1]
-    if count == 0:
-        return None
+    ``table`` is its label's :func:`quantile_tables` part, (T, C, QUANTILES); the reference is the mixture
+    of the frames its pixels' matches ``frames_used`` name, each weighted by its count."""
     frames, channels, quantiles = table.shape
     uses = np.bincount(frames_used, minlength=frames)[:frames].astype(np.float64)
     uses[np.isnan(table[:, 0, 0])] = 0.0
@@ -160,23 +140,139 @@ def _segment_remapping(values: np.ndarray, frames_used: np.ndarray, table: np.nd
     if used.size == 0:
         return None
     weights = np.repeat(uses[used] / (uses[used].sum() * quantiles), quantiles)
-    ranks = (np.arange(count) + 0.5) / count  # the quantile each value moves to, by its rank
-    remapping = []
-    for channel in range(channels):
-        pool = table[used, channel].ravel()
-        order = np.argsort(pool, kind="stable")
-        cumulative = np.cumsum(weights[order]) - 0.5 * weights[order]
-        remapping.append((_rank_order(values[channel]),
-                          np.interp(ranks, cumulative, pool[order]).astype(np.float32)))
-    return remapping
+    pool = table[used].transpose(1, 0, 2).reshape(channels, -1).astype(np.float64)
+    order = np.argsort(pool, axis=1, kind="stable")
+    ordered_weights = weights[order]
+    return np.cumsum(ordered_weights, axis=1) - 0.5 * ordered_weights, np.take_along_axis(pool, order, axis=1)
 
 
-def _rank_order(values: np.ndarray) -> np.ndarray:
-    """The order that sorts ``values``, by a stable radix sort of them rescaled to 16 bits.
+@exact_kernel
+def _interpolate(x, xp, fp, count):
+    """``np.interp(x, xp[:count], fp[:count])`` in float64 for ascending ``xp`` (of a run of equal ``xp``, the
+    last counts)."""
+    if x >= xp[count - 1]:
+        return np.float64(fp[count - 1])
+    if x < xp[0]:
+        return np.float64(fp[0])
+    low, high = 0, count - 1  # xp[low] <= x < xp[high]
+    while high - low > 1:
+        middle = (low + high) // 2
+        if xp[middle] <= x:
+            low = middle
+        else:
+            high = middle
+    slope = (np.float64(fp[high]) - np.float64(fp[low])) / (np.float64(xp[high]) - np.float64(xp[low]))
+    return slope * (x - np.float64(xp[low])) + np.float64(fp[low])
 
-    Eight times faster than a stable float sort at 60 000 values; values closer than
-    1/65 535 of their range keep their index order among themselves, which moves their
-    remapped values by less than that range's 1/65 535 as well."""
-    low, high = float(values.min()), float(values.max())
-    scale = 65535.0 / (high - low) if high > low else 0.0
-    return np.argsort(((values - low) * scale + 0.5).astype(np.uint16), kind="stable")
+
+@exact_kernel
+def _remap_segments(flat, pixels, by_label, starts, tasks, levels, values_at, lengths, remapped, ranked, wanted,
+                    part, parts):
+    """Per (segment, channel) task with a reference (``tasks``, largest first, dealt each to the part with the
+    least work so far): rank the segment's votes and give the k-th of n the reference's value at level
+    (k + ½) / n; ``ranked`` and ``wanted`` keep both in rank order.
+
+    Ranks come from a stable counting sort of the votes rescaled to 16 bits: values closer than 1/65 535 of
+    their range keep their image order among themselves, which moves their remapped values by less than that
+    range's 1/65 535 as well."""
+    load = np.zeros(parts, np.int64)
+    counts = np.empty(65536, np.int32)
+    values = np.empty(by_label.shape[0], np.float32)
+    keys = np.empty(by_label.shape[0], np.int32)
+    order = np.empty(by_label.shape[0], np.int32)
+    for task in range(tasks.shape[0]):
+        label, channel = tasks[task, 0], tasks[task, 1]
+        begin, end = starts[label], starts[label + 1]
+        count = end - begin
+        lightest = 0
+        for other in range(parts):
+            if load[other] < load[lightest]:
+                lightest = other
+        load[lightest] += count
+        if lightest != part:
+            continue
+        low = flat[pixels[by_label[begin]], channel]
+        high = low
+        for member in range(count):
+            value = flat[pixels[by_label[begin + member]], channel]
+            values[member] = value
+            low = min(low, value)
+            high = max(high, value)
+        scale = np.float32(65535.0 / (np.float64(high) - np.float64(low))) if high > low else np.float32(0.0)
+        counts[:] = 0
+        for member in range(count):
+            keys[member] = int((values[member] - low) * scale + np.float32(0.5))
+            counts[keys[member]] += 1
+        total = 0
+        for key in range(65536):
+            total, counts[key] = total + counts[key], total
+        for member in range(count):
+            order[counts[keys[member]]] = member
+            counts[keys[member]] += 1
+        # the levels (rank + ½) / count ascend with the rank: walk the reference alongside
+        xp, fp, length = levels[label, channel], values_at[label, channel], lengths[label]
+        low_index = 0
+        for rank in range(count):
+            level = (rank + 0.5) / count
+            while low_index + 1 < length and xp[low_index + 1] <= level:
+                low_index += 1
+            if level >= xp[length - 1]:
+                moved = np.float32(fp[length - 1])
+            elif level < xp[0]:
+                moved = np.float32(fp[0])
+            else:
+                slope = (fp[low_index + 1] - fp[low_index]) / (xp[low_index + 1] - xp[low_index])
+                moved = np.float32(slope * (level - xp[low_index]) + fp[low_index])
+            member = order[rank]
+            remapped[by_label[begin + member], channel] = moved
+            ranked[channel, begin + rank] = values[member]
+            wanted[channel, begin + rank] = moved
+
+
+@exact_kernel
+def _blend_remappings(flat, pixels, own, weights, has_reference, starts, ranked, wanted, remapped, part, parts):
+    """Where a pixel takes some of another segment's remapping, mix them by ``weights`` (labels, H·W), in place.
+
+    The pixel's own remapping keeps its exact (rank) value; another segment's is read as a function of the
+    value. Only segments with a reference count. Pixels in blocks of 1024, every ``parts``-th."""
+    labels = min(has_reference.shape[0], weights.shape[0])
+    channels = flat.shape[1]
+    mixed = np.empty(channels, np.float32)
+    for block in range(part, (pixels.shape[0] + 1023) // 1024, parts):
+        for index in range(block * 1024, min(pixels.shape[0], block * 1024 + 1024)):
+            pixel = pixels[index]
+            label_here = own[index]
+            own_weight = weights[label_here, pixel] if label_here < labels and has_reference[label_here] else \
+                np.float32(0.0)
+            others = np.float32(0.0)
+            for label in range(labels):
+                if has_reference[label]:
+                    others += weights[label, pixel]
+            if not others > own_weight:
+                continue
+            total = own_weight
+            for channel in range(channels):
+                mixed[channel] = own_weight * remapped[index, channel]
+            for label in range(labels):
+                weight = weights[label, pixel]
+                if label == label_here or not has_reference[label] or not weight > 0:
+                    continue
+                begin, count = starts[label], starts[label + 1] - starts[label]
+                for channel in range(channels):
+                    read = _interpolate(np.float64(flat[pixel, channel]), ranked[channel, begin:begin + count],
+                                        wanted[channel, begin:begin + count], count)
+                    mixed[channel] = np.float32(np.float64(mixed[channel]) + np.float64(weight) * read)
+                total += weight
+            if total > 0:
+                for channel in range(channels):
+                    remapped[index, channel] = mixed[channel] / total
+
+
+@exact_kernel
+def _move_towards(flat, pixels, remapped, strength, part, parts):
+    """``flat[pixel] += strength · (remapped − flat[pixel])`` for the matched pixels, in blocks of 1024."""
+    for block in range(part, (pixels.shape[0] + 1023) // 1024, parts):
+        for index in range(block * 1024, min(pixels.shape[0], block * 1024 + 1024)):
+            for channel in range(flat.shape[1]):
+                value = flat[pixels[index], channel]
+                flat[pixels[index], channel] = value + strength * (remapped[index, channel] - value)

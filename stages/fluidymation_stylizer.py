@@ -30,7 +30,7 @@ class FluidymationStylizer(Stylizer):
     defaults = resources.files("fluidymation.configs").joinpath("fluidymation.yaml")
     writes_nnf = True
     warm_up_modules = tuple(f"fluidymation.engine.{name}" for name in (
-        "nnf", "patch_cost", "patchmatch", "pyramid", "shiftnnf", "uniformity", "vote"))
+        "histogram", "nnf", "patch_cost", "patchmatch", "pyramid", "shiftnnf", "uniformity", "vote"))
     ablation = (
         ("full", ()),
         ("no bound", ("w_bound",)),

@@ -337,3 +337,51 @@ def naive_patch_distance(image, sources, centres, patch_size):
         patch = image[y - half:y + half + 1, x - half:x + half + 1].transpose(2, 0, 1).reshape(-1)
         best.append(((library - patch) ** 2).mean(axis=1).min())
     return float(np.mean(best))
+
+
+def naive_match_histograms(colour, nnf_frame, target_segment, tables, strength, blend=None):
+    """Histogram matching pixel by pixel: per segment and channel, the k-th smallest of its n votes moves to the
+    value at level (k + ½)/n of the match-weighted mixture of its frames' quantiles; with ``blend``, a pixel
+    mixes its own value with the other segments' remappings read as functions of the value (np.interp)."""
+    import numpy as np
+
+    frames, labels, channels, quantiles = tables.shape
+    height, width = nnf_frame.shape
+    members = {label: [(y, x) for y in range(height) for x in range(width)
+                       if nnf_frame[y, x] >= 0 and target_segment[y, x] == label] for label in range(labels)}
+    remapped = colour.astype(np.float64)
+    curves = {}  # label -> per channel (sorted votes, their remapped values)
+    for label, pixels in members.items():
+        mixture = [(frame, sum(nnf_frame[y, x] == frame for y, x in pixels)) for frame in range(frames)
+                   if not np.isnan(tables[frame, label, 0, 0])]
+        mixture = [(frame, uses) for frame, uses in mixture if uses > 0]
+        if not pixels or not mixture:
+            continue
+        total = sum(uses for _, uses in mixture)
+        curves[label] = []
+        for channel in range(channels):
+            points = sorted((float(tables[frame, label, channel, q]), uses / (total * quantiles))
+                            for frame, uses in mixture for q in range(quantiles))
+            weights = np.array([weight for _, weight in points])
+            levels = np.cumsum(weights) - 0.5 * weights
+            votes = sorted((float(colour[y, x, channel]), (y, x)) for y, x in pixels)
+            moved = [np.interp((rank + 0.5) / len(votes), levels, [value for value, _ in points])
+                     for rank in range(len(votes))]
+            for (_, (y, x)), value in zip(votes, moved):
+                remapped[y, x, channel] = value
+            curves[label].append(([value for value, _ in votes], moved))
+    out = remapped.copy()
+    if blend is not None:
+        for label, pixels in members.items():
+            for y, x in pixels:
+                own = blend[label, y, x] if label in curves else 0.0
+                others = {other: blend[other, y, x] for other in curves if other != label and blend[other, y, x] > 0}
+                if not others:
+                    continue
+                total = own + sum(others.values())
+                for channel in range(channels):
+                    mixed = own * remapped[y, x, channel] + sum(
+                        weight * np.interp(colour[y, x, channel], *curves[other][channel])
+                        for other, weight in others.items())
+                    out[y, x, channel] = mixed / total
+    return colour + strength * (out - colour)

@@ -1,8 +1,10 @@
 """Histogram matching of a vote to the distribution of the source frames its matches use."""
 
 import numpy as np
+import pytest
 
 from fluidymation.engine.histogram import QUANTILES, join_tables, match_histograms, quantile_tables
+from tests.naive import naive_match_histograms
 
 
 def _source():
@@ -94,3 +96,21 @@ def test_tables_of_frame_ranges_join_into_the_whole():
     assert joined.shape == whole.shape
     np.testing.assert_array_equal(joined[0], whole[0])
     assert np.isnan(joined[1, 1]).all()
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_matches_the_naive_remapping(seed):
+    """Random votes (distinct beyond 1/65 535 of their range, so the 16-bit ranking is exact), up to three
+    segments, unmatched pixels, frames lacking a label, with and without a blend."""
+    rng = np.random.default_rng(seed)
+    height, width, labels, frames = 7, 9, 1 + seed % 3, 1 + seed % 4
+    vote = (rng.permutation(height * width * 3) / (height * width * 3)).astype(np.float32).reshape(height, width, 3)
+    nnf_frame = rng.integers(-1, frames, (height, width)).astype(np.int32)
+    target_segment = rng.integers(-1, labels, (height, width)).astype(np.int32)
+    source_segment = rng.integers(0, labels, (frames, 6, 6))
+    source_segment[0] = 0
+    tables = quantile_tables(rng.random((frames, 6, 6, 3), dtype=np.float32), source_segment, labels)
+    blend = None if seed % 2 else rng.random((labels, height, width)).astype(np.float32)
+    out = match_histograms(vote, nnf_frame, target_segment, tables, 0.75, blend)
+    expected = naive_match_histograms(vote, nnf_frame, target_segment, tables, 0.75, blend)
+    np.testing.assert_allclose(out, expected, atol=2e-6)
