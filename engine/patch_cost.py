@@ -781,7 +781,8 @@ def target_patch_cost(features, *, target_colour, target_guides, colour_weights,
     else:
         target_weights = feature_weights.reshape(1, 1, -1).copy()
     swap = features.opposite_feature
-    swapped_codes = target_codes[..., swap] if features.use_opposite else target_codes
+    # contiguous: indexing the last axis lays the features out first, and every kernel_cost() would copy them
+    swapped_codes = np.ascontiguousarray(target_codes[..., swap]) if features.use_opposite else target_codes
     swapped_weights = target_weights
     if features.use_opposite and (group[swap] != group).any():
         swapped_weights = np.ascontiguousarray(target_weights[..., swap])
